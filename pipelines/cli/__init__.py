@@ -1,0 +1,47 @@
+"""The ``gimbaltrack`` command: one parser, one module per subcommand."""
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+
+from pipelines.cli.common import CliError
+
+# Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
+SUBCOMMAND_MODULES = [
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="gimbaltrack",
+        description="Keep a subject framed with a DJI RS gimbal: track it in video, "
+        "turn its position into yaw/pitch rates, and drive the gimbal over CAN (DJI R SDK).",
+    )
+    parser.add_argument("--debug", action="store_true", help="log debug output and show tracebacks")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in SUBCOMMAND_MODULES:
+        importlib.import_module(name).register(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.debug else logging.WARNING,
+                        format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return int(args.func(args) or 0)
+    except CliError as exc:
+        if args.debug:
+            raise
+        print(f"gimbaltrack {args.command}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print(f"gimbaltrack {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,36 @@
+"""What every ``gimbaltrack`` subcommand shares: one-line errors and the python-can bus options."""
+from __future__ import annotations
+
+import argparse
+
+
+class CliError(Exception):
+    """A user-facing failure: printed as one line, exit code ``exit_code``."""
+
+    def __init__(self, message: str, exit_code: int = 2) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
+
+
+def parse_int(text: str) -> int:
+    """An integer in decimal or with a 0x/0o/0b prefix (for ids, SEQ and raw bytes)."""
+    try:
+        return int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+
+
+def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | None = None) -> None:
+    """python-can's own options; unset values fall back to can.rc, CAN_* variables and ~/.canrc."""
+    group = parser.add_argument_group("CAN bus (python-can conventions)")
+    group.add_argument(
+        "-i", "--interface", default=default_interface,
+        help="python-can interface (socketcan, slcan, pcan, kvaser, gs_usb, virtual, udp_multicast, ...) "
+        "or 'sim' for the built-in simulated gimbal"
+        + (f" (default: {default_interface})" if default_interface else
+           " (default: python-can's configuration)"),
+    )
+    group.add_argument("-c", "--channel", help="channel, e.g. can0, /dev/ttyACM0, PCAN_USBBUS1, a multicast group")
+    group.add_argument("-b", "--bitrate", type=int, help="bitrate in bit/s (DJI RS gimbals use 1000000)")
+    group.add_argument("--tx-id", type=parse_int, default=0x223, help="CAN id the host sends on (default 0x223)")
+    group.add_argument("--rx-id", type=parse_int, default=0x222, help="CAN id the host listens on (default 0x222)")

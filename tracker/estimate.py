@@ -1,0 +1,39 @@
+"""The target estimate passed from the tracker to every later stage."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+
+class TrackState(str, Enum):
+    """Where the tracker stands with its subject."""
+
+    TRACKING = "tracking"  # subject followed with good confidence
+    SEARCHING = "searching"  # confidence dropped; predicting and searching near the prediction
+    LOST = "lost"  # subject gone; waiting for re-detection
+
+
+@dataclass(frozen=True, slots=True)
+class TargetEstimate:
+    """One frame's estimate of the subject, in pixels of that frame.
+
+    ``box`` is ``(x, y, w, h)`` with a top-left origin; ``velocity`` is the box centre's
+    velocity in pixels per second; ``timestamp`` is the frame's capture time in seconds
+    (the source's clock, monotonic within a run).
+    """
+
+    box: tuple[float, float, float, float]
+    velocity: tuple[float, float]
+    confidence: float
+    state: TrackState
+    timestamp: float
+    frame_index: int
+
+    @property
+    def center(self) -> tuple[float, float]:
+        x, y, w, h = self.box
+        return (x + w / 2.0, y + h / 2.0)
+
+    @property
+    def found(self) -> bool:
+        return self.state is TrackState.TRACKING
