@@ -1,0 +1,81 @@
+"""Typed payloads for every command, reply and push of the DJI R SDK document, and the decoder
+that turns packets into them."""
+from __future__ import annotations
+
+from gimbal.errors import PayloadError, UnknownMessageError
+from gimbal.messages.base import (CAMERA_CMD_SET, CMD_SETS, DEVICE_PUSHES, GIMBAL_CMD_SET,
+                                  HOST_MESSAGES, REPLIES, Kind, Message, Sender, Tlv,
+                                  all_message_classes)
+from gimbal.messages.camera import *  # noqa: F401,F403  (registers the classes)
+from gimbal.messages.external import *  # noqa: F401,F403
+from gimbal.messages.kinds import Command, DevicePush, HostPush, Reply, ReturnCodeReply
+from gimbal.messages.motion import *  # noqa: F401,F403
+from gimbal.messages.settings import *  # noqa: F401,F403
+from gimbal.messages.telemetry import *  # noqa: F401,F403
+from gimbal.messages.tlv_params import *  # noqa: F401,F403
+from gimbal.packet import NO_REPLY, REPLY_REQUIRED, Packet
+
+
+def _pick(candidates: list[type[Message]], payload: bytes, what: str) -> type[Message]:
+    for cls in candidates:
+        if cls.matches(payload):
+            return cls
+    raise UnknownMessageError(f"{what}: no layout in the document matches payload {payload.hex(' ')}")
+
+
+def is_legacy_reply(packet: Packet) -> bool:
+    """Legacy firmware omits CmdSet/CmdID in replies. A return code (0x00/0x01/0x02/0xFF) can
+    never be a CmdSet (0x0D/0x0E), so the first data byte tells the layouts apart."""
+    return packet.is_reply and (not packet.data or packet.data[0] not in CMD_SETS)
+
+
+def decode_message(packet: Packet, request: type[Message] | Message | None = None) -> Message:
+    """The typed message a packet carries.
+
+    Pushes are classified by CmdSet/CmdID whatever the reply bit says (some firmware sets it on
+    pushes). A legacy reply needs ``request``, the command it answers (class or instance).
+    Raises ``PayloadError`` (or its subclass ``UnknownMessageError``).
+    """
+    data = packet.data
+    key = (data[0], data[1]) if len(data) >= 2 else None
+    if key in DEVICE_PUSHES:
+        cls = _pick(DEVICE_PUSHES[key], data[2:], f"push 0x{key[0]:02X}/0x{key[1]:02X}")
+        return cls.decode_payload(data[2:])
+    if packet.is_reply:
+        return _decode_reply(packet, request)
+    if key is None or key not in HOST_MESSAGES:
+        raise UnknownMessageError(f"command {data[:2].hex(' ')} is not defined by the document")
+    cls = _pick(HOST_MESSAGES[key], data[2:], f"command 0x{key[0]:02X}/0x{key[1]:02X}")
+    return cls.decode_payload(data[2:])
+
+
+def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Message:
+    if is_legacy_reply(packet):
+        if request is None:
+            raise UnknownMessageError("legacy-layout reply (no CmdSet/CmdID) without the command it answers")
+        key, payload = (request.CMD_SET, request.CMD_ID), packet.data
+    else:
+        key, payload = (packet.data[0], packet.data[1]), packet.data[2:]
+    expected = getattr(request, "REPLY", None)
+    if expected is not None and (expected.CMD_SET, expected.CMD_ID) == key:
+        return expected.decode_payload(payload)
+    if key not in REPLIES:
+        raise UnknownMessageError(f"reply to 0x{key[0]:02X}/0x{key[1]:02X}: the document defines none")
+    return _pick(REPLIES[key], payload, f"reply 0x{key[0]:02X}/0x{key[1]:02X}").decode_payload(payload)
+
+
+def message_packet(message: Message, seq: int, cmd_type: int | None = None,
+                   legacy: bool = False) -> Packet:
+    """Wrap a message in a packet. Commands want a reply when the document defines one; pushes
+    want none; ``legacy`` builds a reply in the old layout."""
+    payload = message.encode_payload()
+    if message.KIND is Kind.REPLY:
+        return Packet.reply(message.CMD_SET, message.CMD_ID, payload, seq, legacy=legacy)
+    if cmd_type is None:
+        cmd_type = REPLY_REQUIRED if message.REPLY is not None else NO_REPLY
+    return Packet.command(message.CMD_SET, message.CMD_ID, payload, seq, cmd_type)
+
+
+__all__ = ["CAMERA_CMD_SET", "GIMBAL_CMD_SET", "Command", "DevicePush", "HostPush", "Kind", "Message",
+           "PayloadError", "Reply", "ReturnCodeReply", "Sender", "Tlv", "UnknownMessageError",
+           "all_message_classes", "decode_message", "is_legacy_reply", "message_packet"]

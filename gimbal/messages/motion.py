@@ -1,0 +1,108 @@
+"""Position control (0x0E/0x00), speed control (0x01) and angle read-out (0x02)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from gimbal.messages.base import GIMBAL_CMD_SET, register
+from gimbal.messages.kinds import Command, Reply, ReturnCodeReply
+
+YAW_ANGLE_RANGE = (-1800, 1800)
+ROLL_ANGLE_RANGE = (-300, 300)
+PITCH_ANGLE_RANGE = (-560, 1460)
+SPEED_RANGE = (-3600, 3600)  # the document gives 0..360 °/s as a magnitude; the sign is direction
+
+POSITION_ABSOLUTE = 0x01
+POSITION_YAW_INVALID = 0x02
+POSITION_ROLL_INVALID = 0x04
+POSITION_PITCH_INVALID = 0x08
+SPEED_TAKE_CONTROL = 0x80  # bit 7: 1 take, 0 release speed control
+SPEED_IGNORE_FOCAL_LENGTH = 0x08  # bit 3: speed does not depend on the camera's focal length
+
+ANGLES_NONE = 0x00
+ANGLES_ATTITUDE = 0x01
+ANGLES_JOINT = 0x02
+
+
+@register
+@dataclass
+class PositionControlReply(ReturnCodeReply):
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x00
+    NAME: ClassVar[str] = "position_control_reply"
+
+
+@register
+@dataclass
+class PositionControl(Command):
+    """Move to an angle (absolute or relative) in ``time_for_action`` × 0.1 s."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x00
+    NAME: ClassVar[str] = "position_control"
+    FORMAT: ClassVar[str] = "hhhBB"
+    RANGES: ClassVar = {"yaw_angle": YAW_ANGLE_RANGE, "roll_angle": ROLL_ANGLE_RANGE,
+                        "pitch_angle": PITCH_ANGLE_RANGE, "ctrl_byte": (0, 0x0F)}
+    REPLY: ClassVar = PositionControlReply
+    yaw_angle: int = 0
+    roll_angle: int = 0
+    pitch_angle: int = 0
+    ctrl_byte: int = POSITION_ABSOLUTE
+    time_for_action: int = 20
+
+
+@register
+@dataclass
+class SpeedControlReply(ReturnCodeReply):
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x01
+    NAME: ClassVar[str] = "speed_control_reply"
+
+
+@register
+@dataclass
+class SpeedControl(Command):
+    """Rotate at a speed for 0.5 s (resend to keep moving); bit 7 of ctrl_byte takes control."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x01
+    NAME: ClassVar[str] = "speed_control"
+    FORMAT: ClassVar[str] = "hhhB"
+    RANGES: ClassVar = {"yaw_speed": SPEED_RANGE, "roll_speed": SPEED_RANGE, "pitch_speed": SPEED_RANGE}
+    CHOICES: ClassVar = {"ctrl_byte": frozenset({0x00, 0x08, 0x80, 0x88})}  # reserved bits are 0
+    REPLY: ClassVar = SpeedControlReply
+    yaw_speed: int = 0
+    roll_speed: int = 0
+    pitch_speed: int = 0
+    ctrl_byte: int = SPEED_TAKE_CONTROL | SPEED_IGNORE_FOCAL_LENGTH
+
+
+@register
+@dataclass
+class AnglesReply(Reply):
+    """``data_type`` 1: attitude angles, 2: joint angles, 0: not ready."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x02
+    NAME: ClassVar[str] = "get_angles_reply"
+    FORMAT: ClassVar[str] = "BBhhh"
+    CHOICES: ClassVar = {"data_type": frozenset({ANGLES_NONE, ANGLES_ATTITUDE, ANGLES_JOINT})}
+    return_code: int = 0
+    data_type: int | None = None
+    yaw: int | None = None
+    roll: int | None = None
+    pitch: int | None = None
+
+
+@register
+@dataclass
+class GetAngles(Command):
+    """Ask for the attitude (``ctrl_byte`` 1) or joint (2) angles."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x02
+    NAME: ClassVar[str] = "get_angles"
+    FORMAT: ClassVar[str] = "B"
+    CHOICES: ClassVar = {"ctrl_byte": frozenset({ANGLES_NONE, ANGLES_ATTITUDE, ANGLES_JOINT})}
+    REPLY: ClassVar = AnglesReply
+    ctrl_byte: int = ANGLES_ATTITUDE

@@ -1,0 +1,146 @@
+"""Parameter push control (0x0E/0x07), the parameter push (0x08) and module versions (0x09)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from gimbal.messages.base import GIMBAL_CMD_SET, register
+from gimbal.messages.kinds import Command, DevicePush, HostPush, Reply, ReturnCodeReply
+from gimbal.messages.settings import LIMIT_RANGES, STIFFNESS_RANGES
+
+PUSH_NO_OPERATION = 0x00
+PUSH_ENABLE = 0x01
+PUSH_DISABLE = 0x02
+
+FLAG_ANGLES_VALID = 0x01
+FLAG_LIMITS_VALID = 0x02
+FLAG_STIFFNESS_VALID = 0x04
+
+DEVICE_ID_RESERVED = 0x00000000
+DEVICE_ID_R_SDK = 0x00000001
+DEVICE_ID_REMOTE_CONTROLLER = 0x00000002
+
+
+@register
+@dataclass
+class PushControlReply(ReturnCodeReply):
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x07
+    NAME: ClassVar[str] = "push_control_reply"
+
+
+@register
+@dataclass
+class PushControl(Command):
+    """Enable (1) or disable (2) the parameter push."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x07
+    NAME: ClassVar[str] = "push_control"
+    FORMAT: ClassVar[str] = "B"
+    CHOICES: ClassVar = {"ctrl_byte": frozenset({PUSH_NO_OPERATION, PUSH_ENABLE, PUSH_DISABLE})}
+    REPLY: ClassVar = PushControlReply
+    ctrl_byte: int = PUSH_ENABLE
+
+
+@register
+@dataclass
+class ParameterPush(DevicePush):
+    """Attitude, joint angles, limits and stiffness, pushed by the gimbal once enabled.
+
+    The first byte is a flags byte (the document calls it ctrl_byte), not a return code. The
+    document spells the joint fields ``*_joint_agnle``; they are named ``*_joint_angle`` here.
+    Shorter pushes seen on real firmware decode with the missing fields as None.
+    """
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x08
+    NAME: ClassVar[str] = "parameter_push"
+    FORMAT: ClassVar[str] = "BhhhhhhBBBBBBBBB"
+    RANGES: ClassVar = {"ctrl_byte": (0, 0x07), **LIMIT_RANGES, **STIFFNESS_RANGES}
+    PARTIAL: ClassVar[bool] = True
+    ctrl_byte: int = FLAG_ANGLES_VALID | FLAG_LIMITS_VALID | FLAG_STIFFNESS_VALID
+    yaw_angle: int | None = None
+    roll_angle: int | None = None
+    pitch_angle: int | None = None
+    yaw_joint_angle: int | None = None
+    roll_joint_angle: int | None = None
+    pitch_joint_angle: int | None = None
+    pitch_max: int | None = None
+    pitch_min: int | None = None
+    yaw_max: int | None = None
+    yaw_min: int | None = None
+    roll_max: int | None = None
+    roll_min: int | None = None
+    pitch_stiffness: int | None = None
+    yaw_stiffness: int | None = None
+    roll_stiffness: int | None = None
+
+    @property
+    def angles_valid(self) -> bool:
+        return bool(self.ctrl_byte & FLAG_ANGLES_VALID) and self.pitch_joint_angle is not None
+
+    @property
+    def limits_valid(self) -> bool:
+        return bool(self.ctrl_byte & FLAG_LIMITS_VALID) and self.roll_min is not None
+
+    @property
+    def stiffness_valid(self) -> bool:
+        return bool(self.ctrl_byte & FLAG_STIFFNESS_VALID) and self.roll_stiffness is not None
+
+
+@register
+@dataclass
+class VersionReply(Reply):
+    """``version`` 0xAABBCCDD means AA.BB.CC.DD."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x09
+    NAME: ClassVar[str] = "version_reply"
+    FORMAT: ClassVar[str] = "BII"
+    return_code: int = 0
+    device_id: int | None = None
+    version: int | None = None
+
+    @property
+    def version_text(self) -> str | None:
+        return None if self.version is None else format_version(self.version)
+
+
+@register
+@dataclass
+class VersionQuery(Command):
+    """Ask for a module's version by device id (1: DJI R SDK)."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x09
+    NAME: ClassVar[str] = "version_query"
+    FORMAT: ClassVar[str] = "I"
+    REPLY: ClassVar = VersionReply
+    device_id: int = DEVICE_ID_R_SDK
+
+    @classmethod
+    def matches(cls, payload: bytes) -> bool:
+        return len(payload) < 8
+
+
+@register
+@dataclass
+class VersionPush(HostPush):
+    """An external device announcing its own version to the gimbal, at 1 Hz, unanswered."""
+
+    CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
+    CMD_ID: ClassVar[int] = 0x09
+    NAME: ClassVar[str] = "version_push"
+    FORMAT: ClassVar[str] = "II"
+    device_id: int = DEVICE_ID_R_SDK
+    version: int = 0
+
+    @classmethod
+    def matches(cls, payload: bytes) -> bool:
+        return len(payload) >= 8
+
+
+def format_version(version: int) -> str:
+    """0xAABBCCDD -> 'AA.BB.CC.DD', the document's notation (each byte as two hex digits)."""
+    return ".".join(f"{(version >> shift) & 0xFF:02X}" for shift in (24, 16, 8, 0))

@@ -1,0 +1,73 @@
+"""Packets <-> 8-byte classic CAN frames on the configured ids, over any python-can bus."""
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+
+import can
+
+from gimbal.framer import Dropped, PacketFramer
+from gimbal.packet import Packet, encode_packet
+
+HOST_TX_ID = 0x223  # the host sends here; the gimbal listens here
+HOST_RX_ID = 0x222  # the gimbal answers here
+CAN_FRAME_DATA = 8
+
+
+def packet_frames(raw: bytes, arbitration_id: int) -> list[can.Message]:
+    """Cut a packet's bytes into classic CAN frames (the last one shorter)."""
+    return [can.Message(arbitration_id=arbitration_id, is_extended_id=False,
+                        data=raw[i:i + CAN_FRAME_DATA])
+            for i in range(0, len(raw), CAN_FRAME_DATA)]
+
+
+class CanTransport:
+    """Sends packets as frames on ``tx_id`` and reassembles packets from frames on ``rx_id``.
+
+    The host uses the defaults; the device side (the simulator) swaps the two ids. Frames with
+    other ids (DJI's accessory traffic, other nodes) are counted and ignored.
+    """
+
+    def __init__(self, bus: can.BusABC, tx_id: int = HOST_TX_ID, rx_id: int = HOST_RX_ID,
+                 send_timeout: float = 0.05) -> None:
+        self.bus = bus
+        self.tx_id = tx_id
+        self.rx_id = rx_id
+        self.send_timeout = send_timeout
+        self.framer = PacketFramer()
+        self.foreign_frames = 0
+        self._send_lock = threading.Lock()
+        self._ready: deque[Packet | Dropped] = deque()
+
+    def send(self, packet: Packet | bytes) -> bytes:
+        """Send one packet; its frames go out back to back. Returns the bytes sent.
+
+        Raises ``can.CanError`` when the bus refuses a frame.
+        """
+        raw = packet if isinstance(packet, bytes) else encode_packet(packet)
+        with self._send_lock:
+            for frame in packet_frames(raw, self.tx_id):
+                self.bus.send(frame, timeout=self.send_timeout)
+        return raw
+
+    def recv(self, timeout: float | None = None) -> Packet | Dropped | None:
+        """The next packet (or drop report) from ``rx_id``; None when ``timeout`` passes first."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while not self._ready:
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+            frame = self.bus.recv(remaining)
+            if frame is None:
+                return None
+            self.feed_frame(frame)
+            if deadline is not None and time.monotonic() >= deadline and not self._ready:
+                return None
+        return self._ready.popleft()
+
+    def feed_frame(self, frame: can.Message) -> None:
+        """Take one received frame (for callers that read the bus themselves)."""
+        if frame.arbitration_id != self.rx_id or frame.is_extended_id or frame.is_error_frame \
+                or frame.is_remote_frame:
+            self.foreign_frames += 1
+            return
+        self._ready.extend(self.framer.feed(bytes(frame.data)))
