@@ -1,0 +1,260 @@
+"""Rate controllers: target estimate + gimbal attitude -> yaw/pitch speed setpoints.
+
+All times (``now``, estimate timestamps, attitude times) must share one monotonic clock.
+"""
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from typing import Protocol
+
+from pipelines.control.camera import CameraModel
+from pipelines.control.direction import Direction, DirectionFilter, compose, wrap_deg
+from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate
+from pipelines.control.pid import Pid
+from tracker.estimate import TargetEstimate, TrackState
+
+
+@dataclass(frozen=True, slots=True)
+class ControlConfig:
+    """Limits, gains and timing of the closed loop (degrees, seconds)."""
+
+    max_speed_dps: float = 180.0
+    max_accel_dps2: float = 900.0
+    kp: float = 8.0  # deg/s per deg of error
+    ki: float = 1.0
+    kd: float = 0.0
+    integral_limit_dps: float = 30.0
+    deadband_deg: float = 0.05
+    feedforward: float = 1.0  # share of the target's angular velocity fed forward
+    actuation_delay_s: float = 0.06  # setpoint -> gimbal motion (keep-alive period, bus, motor lag)
+    max_prediction_s: float = 0.35  # cap on how far ahead the target is extrapolated
+    hold_s: float = 0.1  # after a loss, keep following the prediction this long ...
+    ramp_s: float = 0.2  # ... then ramp linearly to zero speed over this long
+    measurement_std_deg: float = 0.15
+    target_accel_std_dps2: float = 300.0
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.max_speed_dps <= PROTOCOL_MAX_SPEED_DPS:
+            raise ValueError(f"max_speed_dps must be in (0, {PROTOCOL_MAX_SPEED_DPS:g}]")
+        if self.max_accel_dps2 <= 0 or self.hold_s < 0 or self.ramp_s <= 0:
+            raise ValueError("max_accel_dps2 and ramp_s must be positive, hold_s non-negative")
+        if self.max_speed_dps / self.ramp_s > self.max_accel_dps2 * (1 + 1e-9):
+            raise ValueError("the stop ramp from max_speed_dps over ramp_s would exceed max_accel_dps2")
+
+    @property
+    def stop_within_s(self) -> float:
+        """Worst-case time from losing the target to zero speed."""
+        return self.hold_s + self.ramp_s
+
+
+@dataclass(frozen=True, slots=True)
+class RateCommand:
+    """One speed setpoint (deg/s) and why it was chosen.
+
+    ``stamp`` is the capture time of the frame behind it (for the streamer's latency figures);
+    ``mode`` is ``track``, ``hold`` (target missing, following the prediction), ``ramp``
+    (slowing to zero) or ``idle``; errors are world-frame degrees (target minus predicted pointing).
+    """
+
+    yaw_dps: float
+    pitch_dps: float
+    roll_dps: float = 0.0
+    stamp: float | None = None
+    mode: str = "idle"
+    yaw_error_deg: float = 0.0
+    pitch_error_deg: float = 0.0
+    latency_s: float = 0.0
+
+
+class Controller(Protocol):
+    def update(self, estimate: TargetEstimate | None, attitude: tuple[float, float] | None,
+               now: float) -> RateCommand: ...
+
+    def reset(self) -> None: ...
+
+
+def _tracking(estimate: TargetEstimate | None) -> bool:
+    return estimate is not None and estimate.state is TrackState.TRACKING
+
+
+class RateController:
+    """World-frame PID + feed-forward of the target's angular velocity, latency compensated.
+
+    Each detection is turned into a world direction (image offset composed with the gimbal
+    attitude at the frame's time) and filtered by a constant-velocity Kalman filter. The target
+    is extrapolated to when the new setpoint will act (``now + actuation_delay_s``); the gimbal's
+    pointing at that time is predicted from the attitude at frame time plus the setpoints already
+    sent (a Smith predictor), so pipeline latency does not destabilise the loop.
+    Without detections it follows the prediction for ``hold_s``, then ramps to zero over ``ramp_s``.
+    """
+
+    def __init__(self, camera: CameraModel, config: ControlConfig | None = None) -> None:
+        self.camera = camera
+        self.config = config or ControlConfig()
+        self.reset()
+
+    def _pid(self) -> Pid:
+        c = self.config
+        return Pid(c.kp, c.ki, c.kd, output_limit=c.max_speed_dps,
+                   integral_limit=c.integral_limit_dps, deadband=c.deadband_deg)
+
+    def reset(self) -> None:
+        c = self.config
+        self._filter = DirectionFilter(c.measurement_std_deg, c.target_accel_std_dps2)
+        self._pid_yaw, self._pid_pitch = self._pid(), self._pid()
+        self._direction: Direction | None = None
+        self._attitude: tuple[float, float, float] | None = None  # yaw, pitch, time
+        self._sent: deque[tuple[float, float, float]] = deque(maxlen=256)  # time, yaw, pitch
+        self._last_now: float | None = None
+        self._last_good: float = -math.inf
+        self._ramp_from: tuple[float, float] | None = None
+        self._yaw_unwrapped = 0.0
+        self._last = RateCommand(0.0, 0.0)
+
+    def _integrate_sent(self, t0: float, t1: float) -> tuple[float, float]:
+        """Angle (yaw, pitch) swept by the setpoints sent between times t0 and t1."""
+        dyaw = dpitch = 0.0
+        items = list(self._sent)
+        for i, (t, yaw, pitch) in enumerate(items):
+            end = items[i + 1][0] if i + 1 < len(items) else t1
+            span = min(end, t1) - max(t, t0)
+            if span > 0:
+                dyaw += yaw * span
+                dpitch += pitch * span
+        return dyaw, dpitch
+
+    def _pointing(self, t: float) -> tuple[float, float]:
+        """Gimbal (yaw, pitch) at time ``t``: the last known attitude plus the motion of the
+        setpoints sent since, each acting ``actuation_delay_s`` after it was sent."""
+        yaw, pitch, t_ref = self._attitude
+        delay = self.config.actuation_delay_s
+        dyaw, dpitch = self._integrate_sent(t_ref - delay, t - delay)
+        return wrap_deg(yaw + dyaw), pitch + dpitch
+
+    def update(self, estimate: TargetEstimate | None, attitude: tuple[float, float] | None,
+               now: float) -> RateCommand:
+        """One setpoint for the frame behind ``estimate`` (``None``: no frame or no detection).
+
+        ``attitude`` is the gimbal (yaw, pitch) in degrees at the frame's capture time (at ``now``
+        without an estimate); when ``None`` it is dead-reckoned from the setpoints sent.
+        """
+        c = self.config
+        dt = 0.0 if self._last_now is None else now - self._last_now
+        self._last_now = now
+        frame_t = estimate.timestamp if estimate is not None else now
+        if attitude is not None:
+            self._attitude = (attitude[0], attitude[1], frame_t)
+
+        measured = _tracking(estimate) and self._attitude is not None
+        if measured:
+            if now - self._last_good > c.stop_within_s:  # a new acquisition starts afresh
+                self._filter.reset()
+                self._pid_yaw.reset(self._last.yaw_dps)
+                self._pid_pitch.reset(self._last.pitch_dps)
+            world = compose(self._pointing(frame_t), self.camera.pixel_to_angles(*estimate.center))
+            self._direction = self._filter.update(world, frame_t)
+            self._last_good = now
+            self._ramp_from = None
+        elif estimate is not None and self._direction is not None:
+            self._direction = self._filter.update(None, frame_t)
+
+        if dt <= 0.0:  # first call, or no time has passed: nothing new to command
+            return self._last
+        since = now - self._last_good
+        if self._direction is None or since > c.stop_within_s:
+            return self._emit(0.0, 0.0, "idle", dt, estimate, now)
+        if since > c.hold_s:
+            if self._ramp_from is None:
+                self._ramp_from = (self._last.yaw_dps, self._last.pitch_dps)
+            keep = max(0.0, 1.0 - (since - c.hold_s) / c.ramp_s)
+            # validated: max_speed / ramp_s <= max_accel, so the linear ramp respects the limit
+            return self._emit(self._ramp_from[0] * keep, self._ramp_from[1] * keep, "ramp", dt,
+                              estimate, now, limit_accel=False)
+        return self._follow(dt, now, estimate, "track" if measured else "hold")
+
+    def _follow(self, dt: float, now: float, estimate: TargetEstimate | None, mode: str) -> RateCommand:
+        c, d = self.config, self._direction
+        t_act = min(now + c.actuation_delay_s, d.timestamp + c.max_prediction_s)
+        target = d.at(t_act)
+        gimbal = self._pointing(t_act)
+        e_yaw, e_pitch = wrap_deg(target[0] - gimbal[0]), target[1] - gimbal[1]
+        self._yaw_unwrapped += wrap_deg(gimbal[0] - self._yaw_unwrapped)
+        yaw = c.feedforward * d.yaw_rate + self._pid_yaw(e_yaw, dt, measurement=self._yaw_unwrapped)
+        pitch = c.feedforward * d.pitch_rate + self._pid_pitch(e_pitch, dt, measurement=gimbal[1])
+        return self._emit(yaw, pitch, mode, dt, estimate, now, (e_yaw, e_pitch))
+
+    def _emit(self, yaw: float, pitch: float, mode: str, dt: float, estimate: TargetEstimate | None,
+              now: float, errors: tuple[float, float] = (0.0, 0.0), limit_accel: bool = True) -> RateCommand:
+        c = self.config
+        accel = c.max_accel_dps2 if limit_accel else math.inf
+        yaw = limit_rate(self._last.yaw_dps, yaw, c.max_speed_dps, accel, dt)
+        pitch = limit_rate(self._last.pitch_dps, pitch, c.max_speed_dps, accel, dt)
+        self._sent.append((now, yaw, pitch))
+        stamp = estimate.timestamp if estimate is not None else None
+        self._last = RateCommand(yaw, pitch, 0.0, stamp, mode, errors[0], errors[1],
+                                 0.0 if stamp is None else now - stamp)
+        return self._last
+
+
+class ProportionalController:
+    """Baseline as public drivers do it: speed proportional to the pixel error, nothing else.
+
+    ``gain_per_s`` is the loop gain near the image centre (deg/s per deg of error); the pixel
+    gain is ``gain_per_s`` times the degrees per pixel at the centre. On loss it slows to zero
+    as fast as the acceleration limit allows. The attitude is not used.
+    """
+
+    def __init__(self, camera: CameraModel, config: ControlConfig | None = None,
+                 gain_per_s: float = 3.0) -> None:
+        self.camera = camera
+        self.config = config or ControlConfig()
+        self.gain_per_px = gain_per_s * math.degrees(1.0 / camera.focal_px)
+        self.reset()
+
+    def _pid(self) -> Pid:
+        c = self.config
+        return Pid(self.gain_per_px, output_limit=min(c.max_speed_dps, PROTOCOL_MAX_SPEED_DPS),
+                   slew_rate=c.max_accel_dps2)
+
+    def reset(self) -> None:
+        self._pid_yaw, self._pid_pitch = self._pid(), self._pid()
+        self._last_now: float | None = None
+        self._last = RateCommand(0.0, 0.0)
+
+    def update(self, estimate: TargetEstimate | None, attitude: tuple[float, float] | None,
+               now: float) -> RateCommand:
+        dt = 0.0 if self._last_now is None else now - self._last_now
+        self._last_now = now
+        if dt <= 0.0:
+            return self._last
+        if _tracking(estimate):
+            cx, cy = estimate.center
+            dx, dy = cx - self.camera.cx, cy - self.camera.cy
+            mode = "track"
+        else:
+            dx = dy = 0.0
+            mode = "idle"
+        yaw = self._pid_yaw(dx, dt)
+        pitch = self._pid_pitch(-dy, dt)
+        stamp = estimate.timestamp if estimate is not None else None
+        e_yaw, e_pitch = self.camera.pixel_to_angles(self.camera.cx + dx, self.camera.cy + dy)
+        self._last = RateCommand(yaw, pitch, 0.0, stamp, mode, e_yaw, e_pitch,
+                                 0.0 if stamp is None else now - stamp)
+        return self._last
+
+
+CONTROLLERS = {"pid": RateController, "p": ProportionalController}
+
+
+def controller_names() -> list[str]:
+    return list(CONTROLLERS)
+
+
+def make_controller(name: str = "pid", *, camera: CameraModel,
+                    config: ControlConfig | None = None) -> Controller:
+    """A controller by name: ``pid`` (:class:`RateController`) or ``p`` (the baseline)."""
+    if name not in CONTROLLERS:
+        raise ValueError(f"unknown controller {name!r} (choose from {', '.join(CONTROLLERS)})")
+    return CONTROLLERS[name](camera, config)

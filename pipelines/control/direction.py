@@ -1,0 +1,125 @@
+"""World-frame target direction: composing image offsets with the gimbal attitude, and its Kalman filter.
+
+Angles are degrees; yaw positive to the right (clockwise seen from above), pitch positive up.
+The gimbal is modelled as yaw-then-pitch (roll held level), so a target's world direction is
+``Rz(gimbal_yaw) @ Ry(gimbal_pitch) @ ray(offset_yaw, offset_pitch)``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.common import Q_discrete_white_noise
+from filterpy.kalman import KalmanFilter
+
+
+def wrap_deg(angle: float) -> float:
+    """``angle`` wrapped into [-180, 180)."""
+    return (angle + 180.0) % 360.0 - 180.0
+
+
+def _unit(yaw_deg: float, pitch_deg: float) -> np.ndarray:
+    y, p = math.radians(yaw_deg), math.radians(pitch_deg)
+    return np.array([math.cos(p) * math.cos(y), math.cos(p) * math.sin(y), math.sin(p)])
+
+
+def _angles(v: np.ndarray) -> tuple[float, float]:
+    yaw = math.degrees(math.atan2(v[1], v[0]))
+    pitch = math.degrees(math.asin(max(-1.0, min(1.0, float(v[2])))))
+    return wrap_deg(yaw), pitch
+
+
+def _rotation(yaw_deg: float, pitch_deg: float) -> np.ndarray:
+    """Camera frame (forward, right, up) -> world frame for a gimbal at (yaw, pitch)."""
+    cy, sy = math.cos(math.radians(yaw_deg)), math.sin(math.radians(yaw_deg))
+    cp, sp = math.cos(math.radians(pitch_deg)), math.sin(math.radians(pitch_deg))
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[cp, 0.0, -sp], [0.0, 1.0, 0.0], [sp, 0.0, cp]])
+    return rz @ ry
+
+
+def compose(gimbal: tuple[float, float], offset: tuple[float, float]) -> tuple[float, float]:
+    """World (yaw, pitch) of a ray at ``offset`` (yaw, pitch) off the axis of a gimbal at ``gimbal``."""
+    return _angles(_rotation(*gimbal) @ _unit(*offset))
+
+
+def relative(gimbal: tuple[float, float], world: tuple[float, float]) -> tuple[float, float]:
+    """Inverse of :func:`compose`: the offset (yaw, pitch) of world direction ``world`` in the view."""
+    return _angles(_rotation(*gimbal).T @ _unit(*world))
+
+
+@dataclass(frozen=True, slots=True)
+class Direction:
+    """Filtered world direction (deg) and angular velocity (deg/s) at ``timestamp``."""
+
+    yaw: float
+    pitch: float
+    yaw_rate: float
+    pitch_rate: float
+    timestamp: float
+
+    def at(self, t: float) -> tuple[float, float]:
+        """Constant-velocity extrapolation to time ``t`` (yaw wrapped)."""
+        dt = t - self.timestamp
+        return wrap_deg(self.yaw + self.yaw_rate * dt), self.pitch + self.pitch_rate * dt
+
+
+class DirectionFilter:
+    """Constant-velocity Kalman filter on (yaw, pitch); state ``[yaw, yaw', pitch, pitch']``.
+
+    Yaw is kept unwrapped inside the filter (measurements are unwrapped next to the prediction),
+    so crossing +-180 deg does not produce a 360 deg jump.
+    """
+
+    def __init__(self, measurement_std_deg: float = 0.15, accel_std_dps2: float = 300.0,
+                 initial_rate_std_dps: float = 60.0) -> None:
+        self.measurement_std_deg = measurement_std_deg
+        self.accel_std_dps2 = accel_std_dps2
+        self.initial_rate_std_dps = initial_rate_std_dps
+        self._kf: KalmanFilter | None = None
+        self._t = 0.0
+
+    @property
+    def initialized(self) -> bool:
+        return self._kf is not None
+
+    def reset(self) -> None:
+        self._kf = None
+
+    def _start(self, z: tuple[float, float], t: float) -> None:
+        kf = KalmanFilter(dim_x=4, dim_z=2)
+        kf.x = np.array([z[0], 0.0, z[1], 0.0])
+        kf.H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+        kf.R = np.eye(2) * self.measurement_std_deg ** 2
+        pos_var, rate_var = self.measurement_std_deg ** 2, self.initial_rate_std_dps ** 2
+        kf.P = np.diag([pos_var, rate_var, pos_var, rate_var])
+        self._kf, self._t = kf, t
+
+    def _predict(self, t: float) -> None:
+        kf = self._kf
+        dt = t - self._t
+        if dt <= 0.0:
+            return
+        kf.F = np.array([[1.0, dt, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0],
+                         [0.0, 0.0, 1.0, dt], [0.0, 0.0, 0.0, 1.0]])
+        kf.Q = Q_discrete_white_noise(dim=2, dt=dt, var=self.accel_std_dps2 ** 2, block_size=2)
+        kf.predict()
+        self._t = t
+
+    def update(self, measurement: tuple[float, float] | None, timestamp: float) -> Direction | None:
+        """Fold in a (yaw, pitch) measurement at ``timestamp``; ``None`` only predicts.
+
+        Returns the state at ``timestamp`` (``None`` before the first measurement).
+        """
+        if self._kf is None:
+            if measurement is None:
+                return None
+            self._start(measurement, timestamp)
+        else:
+            self._predict(timestamp)
+            if measurement is not None:
+                yaw = self._kf.x[0] + wrap_deg(measurement[0] - self._kf.x[0])
+                self._kf.update(np.array([yaw, measurement[1]]))
+        x = self._kf.x
+        return Direction(wrap_deg(float(x[0])), float(x[2]), float(x[1]), float(x[3]), self._t)

@@ -1,0 +1,13 @@
+"""Speed and acceleration limits applied to every setpoint."""
+from __future__ import annotations
+
+from pipelines.control.pid import clamp
+
+PROTOCOL_MAX_SPEED_DPS = 360.0  # the DJI R SDK speed command range
+
+
+def limit_rate(previous: float, wanted: float, max_speed: float, max_accel: float, dt: float) -> float:
+    """``wanted`` clamped to +-max_speed (and the protocol's 360 deg/s), moving at most
+    ``max_accel * dt`` from ``previous``."""
+    speed = min(max_speed, PROTOCOL_MAX_SPEED_DPS)
+    return clamp(previous + clamp(clamp(wanted, speed) - previous, max_accel * dt), speed)
