@@ -5,6 +5,7 @@ import bisect
 from collections import deque
 from dataclasses import dataclass
 
+from gimbal.messages.telemetry import FLAG_ANGLES_VALID, ParameterPush
 from pipelines.control.direction import wrap_deg
 
 RAW_DEG = 0.1  # the DJI R SDK reports angles in 0.1 deg
@@ -47,12 +48,13 @@ class AttitudeHistory:
         """Record an attitude in the protocol's raw 0.1 deg units."""
         self.add(timestamp, yaw * RAW_DEG, roll * RAW_DEG, pitch * RAW_DEG)
 
-    def on_push(self, msg: object, t: float) -> None:
-        """Callback for ``GimbalClient.on_push(ParameterPush, ...)``: raw yaw/roll/pitch_angle fields.
+    def on_push(self, msg: ParameterPush, t: float) -> None:
+        """Callback for ``GimbalClient.on_push(ParameterPush, ...)``.
 
-        Pushes whose angle-valid flag is known to be clear are skipped.
+        Skips pushes whose angle-valid flag is clear or that stop short of the attitude (short
+        pushes carrying the attitude but not the joint angles are used).
         """
-        if getattr(msg, "angles_valid", True) is False:
+        if not msg.ctrl_byte & FLAG_ANGLES_VALID or msg.pitch_angle is None:
             return
         self.add_raw(t, msg.yaw_angle, msg.roll_angle, msg.pitch_angle)
 

@@ -163,7 +163,7 @@ class RateController:
         if dt <= 0.0:  # first call, or no time has passed: nothing new to command
             return self._last
         since = now - self._last_good
-        if self._direction is None or since > c.stop_within_s:
+        if self._direction is None or since >= c.stop_within_s - 1e-9:
             return self._emit(0.0, 0.0, "idle", dt, estimate, now)
         if since > c.hold_s:
             if self._ramp_from is None:

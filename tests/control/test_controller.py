@@ -1,0 +1,162 @@
+"""The rate controllers in a synthetic closed loop (tests/control/control_scene.py)."""
+import math
+
+import numpy as np
+import pytest
+
+from control_scene import run_scene
+from pipelines.control.camera import CameraModel
+from pipelines.control.controller import (
+    ControlConfig, ProportionalController, RateController, controller_names, make_controller,
+)
+from tracker.estimate import TargetEstimate, TrackState
+
+CAM = CameraModel(640, 360)
+
+
+def ramp(t):
+    return 20.0 * t, 5.0 * t
+
+
+def sine(t):
+    return 15.0 * math.sin(math.pi * t), 5.0 * math.sin(0.6 * math.pi * t)
+
+
+def pid():
+    return make_controller("pid", camera=CAM)
+
+
+def baseline():
+    return make_controller("p", camera=CAM)
+
+
+def rms(a):
+    return float(np.sqrt(np.mean(np.square(a))))
+
+
+@pytest.mark.parametrize("latency", [0.0, 0.1])
+def test_ramp_steady_state_error_is_near_zero(latency):
+    err = run_scene(pid(), ramp, 5.0, latency=latency).window("err", 2.0)
+    p_err = run_scene(baseline(), ramp, 5.0, latency=latency).window("err", 2.0)
+    assert err.max() < 0.3
+    assert p_err.mean() > 5.0  # a P loop lags a ramp by rate / gain
+    assert err.mean() < 0.05 * p_err.mean()
+
+
+@pytest.mark.parametrize("latency", [0.0, 0.1])
+def test_sine_rms_is_at_most_half_the_baseline(latency):
+    err = run_scene(pid(), sine, 6.0, latency=latency, noise_px=1.0).window("err", 1.0)
+    p_err = run_scene(baseline(), sine, 6.0, latency=latency, noise_px=1.0).window("err", 1.0)
+    assert rms(err) < 0.5 * rms(p_err)
+
+
+def test_step_settles_with_little_overshoot():
+    tr = run_scene(pid(), lambda t: (10.0 if t >= 1.0 else 0.0, 0.0), 4.0)
+    yaw_err = tr.window("yaw_err", 1.0)
+    assert -yaw_err.min() < 0.1 * 10.0  # overshoot under 10 %
+    assert np.abs(tr.window("yaw_err", 3.0)).max() < 0.5
+
+
+def test_latency_compensation_keeps_a_delayed_loop_damped():
+    def overshoot(ctl):
+        tr = run_scene(ctl, lambda t: (10.0 if t >= 1.0 else 0.0, 0.0), 4.0, latency=0.1)
+        return -tr.window("yaw_err", 1.0).min()
+
+    blind = RateController(CAM, ControlConfig(actuation_delay_s=0.0, max_prediction_s=0.0))
+    assert overshoot(pid()) < 0.5
+    assert overshoot(blind) > 3.0  # the same gains without the predictor ring
+
+
+@pytest.mark.parametrize("latency", [0.0, 0.1])
+def test_loss_stops_within_the_configured_time(latency):
+    cfg = ControlConfig()
+    tr = run_scene(RateController(CAM, cfg), lambda t: (40.0 * t, 0.0), 4.0, latency=latency,
+                   hidden=lambda t: t >= 2.0)
+    t, yaw, mode = tr.arr("cmd_t"), tr.arr("cmd_yaw"), tr.arr("mode")
+    last_track = t[mode == "track"].max()
+    assert yaw[t <= last_track].max() > 35.0  # it was following before the loss
+    after = t > last_track + cfg.stop_within_s
+    assert cfg.stop_within_s <= 0.3 + 1e-9
+    assert np.all(yaw[after] == 0.0) and np.all(tr.arr("cmd_pitch")[after] == 0.0)
+    assert set(mode[t > last_track]) <= {"hold", "ramp", "idle"}
+    assert np.all(np.abs(np.diff(yaw[t > last_track])) <= cfg.max_accel_dps2 * (1 / 30) + 1e-9)
+    assert abs(tr.window("gimbal_rate", 3.0)).max() < 1e-3  # and the gimbal stands still
+
+
+def test_no_estimate_at_all_after_tracking_stops_the_gimbal():
+    ctl = pid()
+    for i in range(30):
+        t = i / 30
+        box = (400.0 + 3 * i, 170.0, 20.0, 20.0)
+        ctl.update(TargetEstimate(box, (0, 0), 0.9, TrackState.TRACKING, t, i), (0.0, 0.0), t)
+    moving = ctl.update(None, None, 1.0).yaw_dps
+    assert moving > 0
+    cmds = [ctl.update(None, None, 1.0 + i / 30) for i in range(1, 30)]
+    stopped = [c for c in cmds if c.yaw_dps == 0.0 and c.pitch_dps == 0.0]
+    assert stopped and stopped[0].mode in {"ramp", "idle"}
+    assert all(c.yaw_dps == 0.0 for c in cmds[cmds.index(stopped[0]):])
+    assert (cmds.index(stopped[0]) + 2) / 30 <= 0.3 + 1e-9  # the last detection was at 29/30 s
+
+
+def test_searching_holds_the_prediction_then_ramps_down():
+    ctl = pid()
+    for i in range(40):
+        t = i / 30
+        box = (300.0 + 2 * i, 170.0, 20.0, 20.0)
+        ctl.update(TargetEstimate(box, (0, 0), 0.9, TrackState.TRACKING, t, i), (0.0, 0.0), t)
+    modes = []
+    for i in range(40, 60):
+        t = i / 30
+        est = TargetEstimate((380.0, 170.0, 20.0, 20.0), (0, 0), 0.2, TrackState.SEARCHING, t, i)
+        modes.append(ctl.update(est, (0.0, 0.0), t).mode)
+    assert modes[0] == "hold" and "ramp" in modes and modes[-1] == "idle"
+
+
+def test_limits_hold_for_a_target_too_fast_to_follow():
+    cfg = ControlConfig(max_speed_dps=90.0, max_accel_dps2=450.0)
+    for ctl in (RateController(CAM, cfg), ProportionalController(CAM, cfg, gain_per_s=20.0)):
+        tr = run_scene(ctl, lambda t: (200.0 * t, 60.0 * math.sin(3 * t)), 3.0, latency=0.05)
+        yaw, pitch, t = tr.arr("cmd_yaw"), tr.arr("cmd_pitch"), tr.arr("cmd_t")
+        assert np.abs(yaw).max() <= 90.0 and np.abs(pitch).max() <= 90.0
+        for axis in (yaw, pitch):
+            assert np.all(np.abs(np.diff(axis)) <= 450.0 * np.diff(t) + 1e-9)
+        assert np.all(tr.arr("cmd_roll") == 0.0)
+
+
+def test_yaw_wrap_does_not_upset_the_loop():
+    tr = run_scene(pid(), lambda t: (170.0 + 20.0 * t, 0.0), 2.0)
+    # the loop starts at yaw 0 facing a target at 170: lost at once, so start it facing the target
+    assert np.all(tr.arr("cmd_yaw") == 0.0)
+    ctl = pid()
+    cmds = []
+    for i in range(90):  # gimbal and target both cross +-180 deg
+        t = i / 30
+        yaw = ((175.0 + 20.0 * t) + 180.0) % 360.0 - 180.0
+        est = TargetEstimate((310.0, 170.0, 20.0, 20.0), (0, 0), 0.9, TrackState.TRACKING, t, i)
+        cmds.append(ctl.update(est, (yaw, 0.0), t))
+    assert max(abs(c.yaw_dps) for c in cmds) < 30.0
+    assert max(abs(c.yaw_error_deg) for c in cmds) < 2.0
+
+
+def test_missing_attitude_is_dead_reckoned_from_the_setpoints():
+    ctl = pid()
+
+    class FirstAttitudeOnly:
+        def update(self, est, att, now):
+            att = att if now == 0.0 else None
+            return ctl.update(est, att, now)
+
+    err = run_scene(FirstAttitudeOnly(), ramp, 4.0, tau=0.02).window("err", 2.0)
+    assert err.max() < 1.0
+
+
+def test_config_validation_and_factory():
+    with pytest.raises(ValueError):
+        ControlConfig(max_speed_dps=400.0)
+    with pytest.raises(ValueError):  # 180 deg/s to zero in 0.1 s needs 1800 deg/s^2
+        ControlConfig(ramp_s=0.1, max_accel_dps2=900.0)
+    assert controller_names() == ["pid", "p"]
+    assert isinstance(make_controller(camera=CAM), RateController)
+    assert isinstance(make_controller("p", camera=CAM), ProportionalController)
+    with pytest.raises(ValueError):
+        make_controller("lqr", camera=CAM)

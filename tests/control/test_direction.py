@@ -1,0 +1,57 @@
+import math
+
+import pytest
+from hypothesis import given, strategies as st
+
+from pipelines.control.direction import DirectionFilter, compose, relative, wrap_deg
+
+angles = st.floats(-179.9, 179.9)
+pitches = st.floats(-80, 80)
+
+
+def test_wrap():
+    assert wrap_deg(180.0) == -180.0
+    assert wrap_deg(-181.0) == pytest.approx(179.0)
+    assert wrap_deg(541.0) == pytest.approx(-179.0)
+
+
+def test_compose_level_gimbal_adds_yaw_across_the_wrap():
+    assert compose((0.0, 0.0), (12.0, -7.0)) == pytest.approx((12.0, -7.0))
+    assert compose((179.0, 0.0), (3.0, 0.0)) == pytest.approx((-178.0, 0.0))
+    assert compose((-178.0, 0.0), (-4.0, 2.0)) == pytest.approx((178.0, 2.0))
+
+
+def test_compose_pitched_gimbal_is_not_a_plain_sum():
+    # looking 60 deg up, a target 10 deg right in the image is ~20 deg of world yaw away
+    yaw, pitch = compose((0.0, 60.0), (10.0, 0.0))
+    assert yaw == pytest.approx(math.degrees(math.atan(math.tan(math.radians(10)) / math.cos(math.radians(60)))))
+    assert pitch < 60.0
+
+
+@given(angles, pitches, st.floats(-60, 60), st.floats(-60, 60))
+def test_relative_inverts_compose(gy, gp, oy, op):
+    world = compose((gy, gp), (oy, op))
+    assert relative((gy, gp), world) == pytest.approx((oy, op), abs=1e-6)
+
+
+def test_filter_follows_a_ramp_across_the_wrap_without_a_jump():
+    kf = DirectionFilter()
+    assert kf.update(None, 0.0) is None  # nothing to predict from yet
+    for i in range(90):
+        t = i / 30
+        d = kf.update((wrap_deg(170.0 + 30.0 * t), -5.0 + 6.0 * t), t)
+        assert abs(wrap_deg(d.yaw - (170.0 + 30.0 * t))) < 0.5
+    assert d.yaw_rate == pytest.approx(30.0, abs=0.5)
+    assert d.pitch_rate == pytest.approx(6.0, abs=0.5)
+
+
+def test_update_none_only_predicts():
+    kf = DirectionFilter()
+    for i in range(60):
+        d = kf.update((10.0 * i / 30, 0.0), i / 30)
+    before = kf._kf.P.trace()
+    p = kf.update(None, d.timestamp + 0.5)
+    assert p.yaw == pytest.approx(d.yaw + d.yaw_rate * 0.5, abs=1e-6)
+    assert p.yaw_rate == pytest.approx(d.yaw_rate)
+    assert kf._kf.P.trace() > before  # uncertainty grows, no measurement folded in
+    assert d.at(d.timestamp + 0.5) == pytest.approx((p.yaw, p.pitch))
