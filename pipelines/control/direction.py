@@ -30,7 +30,7 @@ def _angles(v: np.ndarray) -> tuple[float, float]:
     return wrap_deg(yaw), pitch
 
 
-def _rotation(yaw_deg: float, pitch_deg: float) -> np.ndarray:
+def rotation_matrix(yaw_deg: float, pitch_deg: float) -> np.ndarray:
     """Camera frame (forward, right, up) -> world frame for a gimbal at (yaw, pitch)."""
     cy, sy = math.cos(math.radians(yaw_deg)), math.sin(math.radians(yaw_deg))
     cp, sp = math.cos(math.radians(pitch_deg)), math.sin(math.radians(pitch_deg))
@@ -41,12 +41,12 @@ def _rotation(yaw_deg: float, pitch_deg: float) -> np.ndarray:
 
 def compose(gimbal: tuple[float, float], offset: tuple[float, float]) -> tuple[float, float]:
     """World (yaw, pitch) of a ray at ``offset`` (yaw, pitch) off the axis of a gimbal at ``gimbal``."""
-    return _angles(_rotation(*gimbal) @ _unit(*offset))
+    return _angles(rotation_matrix(*gimbal) @ _unit(*offset))
 
 
 def relative(gimbal: tuple[float, float], world: tuple[float, float]) -> tuple[float, float]:
     """Inverse of :func:`compose`: the offset (yaw, pitch) of world direction ``world`` in the view."""
-    return _angles(_rotation(*gimbal).T @ _unit(*world))
+    return _angles(rotation_matrix(*gimbal).T @ _unit(*world))
 
 
 @dataclass(frozen=True, slots=True)

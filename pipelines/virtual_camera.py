@@ -1,0 +1,82 @@
+"""A narrow virtual camera on a simulated gimbal, looking into a wide recorded frame.
+
+The recorded frame is treated as a fixed wide pinhole camera pointing at yaw = pitch = 0; the
+virtual camera sits at the same centre, turned to the gimbal's (yaw, pitch), and sees the part of
+the frame its rotation homography ``K_view R^T K_source^-1`` selects. Ground-truth boxes of the
+recorded frame map into the view the same way, so the centring error is known every frame.
+"""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from pipelines.control.camera import CameraModel
+from pipelines.control.direction import rotation_matrix
+
+# (forward, right, up) -> OpenCV camera axes (x right, y down, z forward)
+_TO_CV = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
+
+Box = tuple[float, float, float, float]
+
+
+def _intrinsics(cam: CameraModel) -> np.ndarray:
+    return np.array([[cam.focal_px, 0.0, cam.cx], [0.0, cam.focal_px, cam.cy], [0.0, 0.0, 1.0]])
+
+
+class VirtualCamera:
+    """The view of an ``out_size`` camera on a gimbal inside a ``source_size`` recorded frame.
+
+    ``hfov_deg`` is the view's horizontal field of view; ``None`` means crop-equivalent (the
+    source's focal length, so a 640x360 view of a 1280x720 frame is its central half at rest).
+    ``source_hfov_deg`` is the recorded camera's field of view (default: 24 mm full frame).
+    """
+
+    def __init__(self, source_size: tuple[int, int], out_size: tuple[int, int] = (640, 360),
+                 hfov_deg: float | None = None, source_hfov_deg: float | None = None) -> None:
+        self.source = CameraModel(*source_size, hfov_deg=source_hfov_deg)
+        if hfov_deg is None:
+            self.camera = CameraModel(*out_size, focal_px=self.source.focal_px)
+        else:
+            self.camera = CameraModel(*out_size, hfov_deg=hfov_deg)
+        self._k_src = _intrinsics(self.source)
+        self._k_view = _intrinsics(self.camera)
+
+    def _view_to_source(self, yaw: float, pitch: float) -> np.ndarray:
+        """Homography from view pixels to source pixels for a gimbal at (yaw, pitch) degrees."""
+        r_cv = _TO_CV @ rotation_matrix(yaw, pitch) @ _TO_CV.T
+        return self._k_src @ r_cv @ np.linalg.inv(self._k_view)
+
+    def render(self, frame: np.ndarray, yaw: float, pitch: float) -> np.ndarray:
+        """What the view sees (black where it looks past the recorded frame)."""
+        h = self._view_to_source(yaw, pitch)
+        return cv2.warpPerspective(frame, h, (self.camera.width, self.camera.height),
+                                   flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                                   borderMode=cv2.BORDER_CONSTANT)
+
+    def to_view(self, points: np.ndarray, yaw: float, pitch: float) -> np.ndarray:
+        """Source pixels (N x 2) -> view pixels (N x 2); NaN for points behind the view."""
+        h = np.linalg.inv(self._view_to_source(yaw, pitch))
+        p = np.c_[np.asarray(points, float).reshape(-1, 2), np.ones(len(points))] @ h.T
+        out = p[:, :2] / p[:, 2:3]
+        out[p[:, 2] <= 0] = np.nan
+        return out
+
+    def box_to_view(self, box: Box, yaw: float, pitch: float) -> Box | None:
+        """The axis-aligned view box around a source box's mapped corners (``None`` if behind)."""
+        x, y, w, h = box
+        corners = self.to_view(np.array([[x, y], [x + w, y], [x, y + h], [x + w, y + h]]), yaw, pitch)
+        if np.isnan(corners).any():
+            return None
+        (x0, y0), (x1, y1) = corners.min(axis=0), corners.max(axis=0)
+        return (float(x0), float(y0), float(x1 - x0), float(y1 - y0))
+
+    def center_error(self, box: Box, yaw: float, pitch: float) -> tuple[float, bool]:
+        """Distance from the box centre to the view centre as a fraction of the view diagonal,
+        and whether the centre lies inside the view."""
+        x, y, w, h = box
+        (cx, cy), = self.to_view(np.array([[x + w / 2, y + h / 2]]), yaw, pitch)
+        cam = self.camera
+        if np.isnan(cx):
+            return 1.0, False
+        inside = 0.0 <= cx < cam.width and 0.0 <= cy < cam.height
+        return float(np.hypot(cx - cam.cx, cy - cam.cy) / cam.diagonal_px), inside
