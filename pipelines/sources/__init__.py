@@ -1,0 +1,40 @@
+"""Frame sources: ``open_source(spec)`` for a video file, an image folder, a camera or a stream URL."""
+from __future__ import annotations
+
+import re
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from pipelines.sources.base import Frame, FrameSource, SourceError
+from pipelines.sources.files import ImageFolderSource, VideoFileSource
+from pipelines.sources.live import DEFAULT_OPEN_TIMEOUT, DEFAULT_STALL_TIMEOUT, open_camera, open_stream
+
+__all__ = ["Frame", "FrameSource", "SourceError", "open_source"]
+
+_URL = re.compile(r"^[a-z][a-z0-9+.-]*://", re.IGNORECASE)
+
+
+def open_source(spec: str, realtime: bool = False, *, fps: float | None = None,
+                stall_timeout: float = DEFAULT_STALL_TIMEOUT,
+                open_timeout: float = DEFAULT_OPEN_TIMEOUT,
+                clock: Callable[[], float] = time.monotonic,
+                sleep: Callable[[float], None] = time.sleep) -> FrameSource:
+    """Open ``spec``: a camera index ("0"), a stream URL, an image folder or a video file.
+
+    Files are read as fast as pulled (timestamps ``index / fps``) or, with ``realtime``, paced at
+    their frame rate (timestamps are ``clock`` readings). ``fps`` overrides or supplies a file's rate
+    (an image folder has none; 30 is assumed). Live sources ignore ``realtime``, ``fps``, ``sleep``
+    and ``clock``: their timestamps are ``time.monotonic()`` at grab, and a live source that delivers
+    nothing for ``stall_timeout`` s raises ``SourceError("stream stalled ...")``.
+    """
+    if spec.isdigit():
+        return open_camera(int(spec), stall_timeout, open_timeout)
+    if _URL.match(spec):
+        return open_stream(spec, stall_timeout, open_timeout)
+    path = Path(spec)
+    if path.is_dir():
+        return ImageFolderSource(path, realtime, fps, clock, sleep)
+    if not path.exists():
+        raise SourceError(f"no such video file or image folder: {spec}")
+    return VideoFileSource(path, realtime, fps, clock, sleep)

@@ -1,0 +1,143 @@
+"""Recorded sources: a video file or a folder of images, read as fast as pulled or paced in real time."""
+from __future__ import annotations
+
+import re
+import time
+from abc import abstractmethod
+from collections.abc import Callable
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from pipelines.sources.base import Frame, FrameSource, SourceError
+
+#: Frame rate assumed for timestamps when a file does not tell its own (OTB sequences are 30 fps).
+ASSUMED_FPS = 30.0
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
+
+
+class Pacer:
+    """Frame times: ``index / fps`` as fast as pulled, or waits for each frame's due time when realtime.
+
+    In real time the first frame anchors the schedule and a frame's timestamp is the clock reading
+    when it is handed out; a consumer that falls behind gets the next frame at once (nothing is
+    skipped).
+    """
+
+    def __init__(self, fps: float, realtime: bool, clock: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
+        if fps <= 0:
+            raise ValueError(f"fps must be positive, got {fps}")
+        self.fps = fps
+        self.realtime = realtime
+        self._clock = clock
+        self._sleep = sleep
+        self._start: float | None = None
+
+    def stamp(self, index: int) -> float:
+        """Wait if the frame is not due yet (real time only) and return its timestamp."""
+        if not self.realtime:
+            return index / self.fps
+        now = self._clock()
+        if self._start is None:
+            self._start = now - index / self.fps
+        due = self._start + index / self.fps
+        if due > now:
+            self._sleep(due - now)
+            now = self._clock()
+        return now
+
+
+class FileSource(FrameSource):
+    """A recorded sequence: frames are decoded when pulled, so none are ever dropped."""
+
+    def __init__(self, description: str, first: np.ndarray, fps: float | None,
+                 frame_count: int | None, pacer: Pacer) -> None:
+        height, width = first.shape[:2]
+        super().__init__(description, (width, height), fps, frame_count, is_live=False)
+        self._pending: np.ndarray | None = first
+        self._pacer = pacer
+        self._index = 0
+        self._closed = False
+
+    def read(self) -> Frame | None:
+        if self._closed:
+            return None
+        if self._pending is not None:
+            image, self._pending = self._pending, None
+        else:
+            image = self._load(self._index)
+            if image is None:
+                return None
+        frame = Frame(image, self._pacer.stamp(self._index), self._index)
+        self._index += 1
+        return frame
+
+    def close(self) -> None:
+        self._closed = True
+        self._pending = None
+
+    @abstractmethod
+    def _load(self, index: int) -> np.ndarray | None:
+        """Image number ``index`` (never 0: that one was read at open), or ``None`` at the end."""
+
+
+class VideoFileSource(FileSource):
+    """A video file decoded by OpenCV's FFmpeg backend."""
+
+    def __init__(self, path: Path, realtime: bool = False, fps: float | None = None,
+                 clock: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
+        if not path.is_file():
+            raise SourceError(f"video file not found: {path}")
+        capture = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG)
+        if not capture.isOpened():
+            raise SourceError(f"cannot open {path}: not a video OpenCV can read")
+        ok, first = capture.read()
+        if not ok or first is None:
+            capture.release()
+            raise SourceError(f"no frame decodes from {path}: unsupported codec or corrupt file")
+        nominal = capture.get(cv2.CAP_PROP_FPS)
+        fps = fps or (nominal if 0 < nominal < 1000 else None)
+        count = int(capture.get(cv2.CAP_PROP_FRAME_COUNT))
+        self._capture = capture
+        super().__init__(str(path), first, fps, count if count > 0 else None,
+                         Pacer(fps or ASSUMED_FPS, realtime, clock, sleep))
+
+    def _load(self, index: int) -> np.ndarray | None:
+        ok, image = self._capture.read()
+        return image if ok else None
+
+    def close(self) -> None:
+        super().close()
+        self._capture.release()
+
+
+def _natural_key(path: Path) -> list[int | str]:
+    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", path.name)]
+
+
+class ImageFolderSource(FileSource):
+    """A folder of .jpg/.png images in natural name order (``img2`` before ``img10``)."""
+
+    def __init__(self, path: Path, realtime: bool = False, fps: float | None = None,
+                 clock: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
+        files = sorted((p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()),
+                       key=_natural_key)
+        if not files:
+            raise SourceError(f"no .jpg or .png images in folder {path}")
+        self._files = files
+        super().__init__(str(path), self._imread(files[0]), fps, len(files),
+                         Pacer(fps or ASSUMED_FPS, realtime, clock, sleep))
+
+    @staticmethod
+    def _imread(path: Path) -> np.ndarray:
+        image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+        if image is None:
+            raise SourceError(f"cannot read image {path}")
+        return image
+
+    def _load(self, index: int) -> np.ndarray | None:
+        return self._imread(self._files[index]) if index < len(self._files) else None

@@ -1,0 +1,165 @@
+"""Live sources: the newest-frame grabber, stalls, open failures and a real UDP stream via FFmpeg."""
+from __future__ import annotations
+
+import itertools
+import os
+import shutil
+import socket
+import subprocess
+import threading
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pipelines.sources import SourceError, open_source
+from pipelines.sources.live import LatestFrameGrabber, LiveSource
+
+WAIT = 10.0  # generous bound for thread hand-offs; tests never assert on durations
+
+
+class BurstCapture:
+    """A fake capture that delivers bursts of frames back to back, then blocks until the next burst
+    is released; after the last burst every read fails (a dead stream)."""
+
+    def __init__(self, bursts: list[int]) -> None:
+        self._bursts = list(bursts)
+        self._served = 0
+        self.burst_done = threading.Event()
+        self._gate = threading.Event()
+        self.released = threading.Event()
+
+    def read(self) -> tuple[bool, np.ndarray | None]:
+        if not self._bursts:
+            return False, None
+        if self._bursts[0] == 0:
+            self._bursts.pop(0)
+            self.burst_done.set()
+            self._gate.wait()
+            self._gate.clear()
+            return self.read()
+        self._bursts[0] -= 1
+        self._served += 1
+        return True, np.full((4, 6, 3), self._served - 1, np.uint8)
+
+    def next_burst(self) -> None:
+        self.burst_done.clear()
+        self._gate.set()
+
+    def release(self) -> None:
+        self.released.set()
+
+
+def counter_clock() -> Callable[[], float]:
+    ticks = itertools.count(1000)
+    return lambda: float(next(ticks))
+
+
+def test_grabber_hands_out_the_newest_frame_and_counts_drops() -> None:
+    capture = BurstCapture([5, 3])
+    grabber = LatestFrameGrabber(capture, clock=counter_clock())
+    grabber.start()
+    try:
+        assert capture.burst_done.wait(WAIT)
+        frame = grabber.get(0.0)
+        assert frame is not None
+        assert (frame.index, int(frame.image[0, 0, 0]), frame.timestamp) == (4, 4, 1004.0)
+        assert grabber.dropped == 4 and grabber.grabbed == 5
+        assert grabber.get(0.0) is None  # nothing newer than what was handed out
+        capture.next_burst()
+        assert capture.burst_done.wait(WAIT)
+        frame = grabber.get(0.0)
+        assert frame is not None and frame.index == 7
+        assert grabber.dropped == 6
+    finally:
+        capture.next_burst()
+        grabber.stop()
+    assert capture.released.wait(WAIT)
+
+
+def test_grabber_failure_reaches_the_consumer() -> None:
+    class Broken:
+        def read(self) -> tuple[bool, np.ndarray | None]:
+            raise RuntimeError("device unplugged")
+
+        def release(self) -> None:
+            pass
+
+    grabber = LatestFrameGrabber(Broken())
+    grabber.start()
+    with pytest.raises(SourceError, match="device unplugged"):
+        grabber.get(WAIT)
+    grabber.stop()
+
+
+def test_live_source_raises_stream_stalled_when_frames_stop() -> None:
+    capture = BurstCapture([3])
+    source = LiveSource(capture, "fake stream", stall_timeout=0.2, open_timeout=WAIT)
+    with source:
+        assert source.is_live and source.size == (6, 4) and source.frame_count is None
+        assert capture.burst_done.wait(WAIT)
+        first = source.read()
+        assert first is not None and first.index == 2  # the newest of the burst
+        assert source.dropped == 2
+        capture.next_burst()  # the stream dies: every read fails from now on
+        with pytest.raises(SourceError, match="stream stalled: no frame from fake stream for 0.2 s"):
+            source.read()
+    assert capture.released.wait(WAIT)
+    assert source.read() is None
+
+
+def test_live_source_that_never_delivers_does_not_open() -> None:
+    with pytest.raises(SourceError, match="no frame from silent within 0.1 s"):
+        LiveSource(BurstCapture([]), "silent", open_timeout=0.1)
+
+
+def test_camera_that_does_not_open() -> None:
+    with pytest.raises(SourceError, match="camera 97 does not open"):
+        open_source("97")
+
+
+def _free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@pytest.fixture
+def ffmpeg() -> str:
+    path = shutil.which("ffmpeg")
+    if path is None:
+        message = "ffmpeg CLI not found (scripts/test.sh installs it): cannot test a live UDP stream"
+        if os.environ.get("CI"):
+            pytest.fail(message)
+        pytest.skip(message)
+    return path
+
+
+@pytest.mark.slow
+def test_udp_stream_is_read_live_and_stalls_when_the_sender_stops(
+        ffmpeg: str, tmp_path: Path, write_video: Callable[..., Path]) -> None:
+    clip = write_video(tmp_path / "clip.mp4", 150, fps=30.0, size=(160, 120))
+    url = f"udp://127.0.0.1:{_free_udp_port()}"
+    sender = subprocess.Popen(
+        [ffmpeg, "-hide_banner", "-loglevel", "error", "-re", "-i", str(clip), "-c:v", "mpeg2video",
+         "-g", "10", "-q:v", "4", "-f", "mpegts", f"{url}?pkt_size=1316"],
+        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        with open_source(url, stall_timeout=1.0, open_timeout=WAIT) as source:
+            assert source.is_live and source.size == (160, 120)
+            frames = [source.read() for _ in range(20)]
+            sender.terminate()
+            sender.wait(WAIT)
+            with pytest.raises(SourceError, match="stream stalled"):
+                while True:
+                    source.read()
+    finally:
+        if sender.poll() is None:
+            sender.kill()
+            sender.wait()
+    indexes = [f.index for f in frames]
+    stamps = [f.timestamp for f in frames]
+    assert indexes == sorted(set(indexes))
+    assert stamps == sorted(stamps) and stamps[0] < stamps[-1]
+    assert all(f.image.shape == (120, 160, 3) for f in frames)
