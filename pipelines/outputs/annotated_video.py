@@ -1,0 +1,91 @@
+"""The annotated video: each frame with the subject box, its centre, the error vector and the rates."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from types import TracebackType
+
+import cv2
+import numpy as np
+
+from tracker.estimate import TargetEstimate, TrackState
+
+#: Container suffix -> FourCC. An .mp4 is finalised by ``close()``; an .avi (Motion JPEG) stays
+#: readable up to the last written frames even if the process is killed.
+CODECS = {".mp4": "mp4v", ".avi": "MJPG"}
+STATE_COLOURS = {  # BGR
+    TrackState.TRACKING: (0, 200, 0),
+    TrackState.SEARCHING: (0, 200, 255),
+    TrackState.LOST: (0, 0, 255),
+}
+_FONT = cv2.FONT_HERSHEY_SIMPLEX
+
+
+def _put_lines(image: np.ndarray, lines: Sequence[str]) -> None:
+    y = 8
+    for line in lines:
+        (w, h), base = cv2.getTextSize(line, _FONT, 0.5, 1)
+        cv2.rectangle(image, (4, y - 2), (12 + w, y + h + base), (0, 0, 0), cv2.FILLED)
+        cv2.putText(image, line, (8, y + h), _FONT, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
+        y += h + base + 6
+
+
+def annotate(image: np.ndarray, estimate: TargetEstimate | None = None,
+             rates_dps: tuple[float, float] | None = None, lines: Sequence[str] = ()) -> np.ndarray:
+    """A copy of ``image`` with the image centre, and if given the box coloured by state, the subject
+    centre cross, the error vector from image centre to subject centre, the state, confidence and
+    commanded yaw/pitch rates (°/s), then any extra text ``lines``."""
+    out = image.copy()
+    height, width = out.shape[:2]
+    centre = (width // 2, height // 2)
+    cv2.drawMarker(out, centre, (200, 200, 200), cv2.MARKER_CROSS, 20, 1)
+    text = []
+    if estimate is not None:
+        colour = STATE_COLOURS[estimate.state]
+        subject = tuple(round(v) for v in estimate.center)
+        cv2.arrowedLine(out, centre, subject, (255, 255, 0), 2, cv2.LINE_AA, tipLength=0.08)
+        x, y, w, h = (round(v) for v in estimate.box)
+        cv2.rectangle(out, (x, y), (x + w, y + h), colour, 2)
+        cv2.drawMarker(out, subject, colour, cv2.MARKER_CROSS, 16, 2)
+        text.append(f"#{estimate.frame_index} t={estimate.timestamp:.3f}s "
+                    f"{estimate.state.value} conf={estimate.confidence:.2f}")
+    if rates_dps is not None:
+        text.append(f"yaw {rates_dps[0]:+.1f} pitch {rates_dps[1]:+.1f} deg/s")
+    _put_lines(out, [*text, *lines])
+    return out
+
+
+class AnnotatedVideoWriter:
+    """Writes annotated frames as they come (.mp4 with mp4v, or .avi with MJPG); ``close()`` finalises."""
+
+    def __init__(self, path: str | os.PathLike[str], size: tuple[int, int], fps: float) -> None:
+        self.path = Path(path)
+        codec = CODECS.get(self.path.suffix.lower())
+        if codec is None:
+            raise ValueError(f"annotated video must end in {' or '.join(CODECS)}: {self.path}")
+        self.size = size
+        self._writer = cv2.VideoWriter(str(self.path), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*codec),
+                                       fps, size)
+        if not self._writer.isOpened():
+            raise OSError(f"cannot write video {self.path}")
+        self.frames = 0
+
+    def write(self, image: np.ndarray, estimate: TargetEstimate | None = None,
+              rates_dps: tuple[float, float] | None = None, lines: Sequence[str] = ()) -> None:
+        """Annotate ``image`` (see ``annotate``) and append it; the size must match the writer's."""
+        height, width = image.shape[:2]
+        if (width, height) != self.size:
+            raise ValueError(f"frame is {width}x{height}, video is {self.size[0]}x{self.size[1]}")
+        self._writer.write(annotate(image, estimate, rates_dps, lines))
+        self.frames += 1
+
+    def close(self) -> None:
+        self._writer.release()
+
+    def __enter__(self) -> AnnotatedVideoWriter:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()

@@ -1,0 +1,68 @@
+"""The annotated video: drawing, frame count on read-back, size checks and crash tolerance of .avi."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from pipelines.outputs.annotated_video import STATE_COLOURS, AnnotatedVideoWriter, annotate
+from pipelines.sources import open_source
+from tracker.estimate import TargetEstimate, TrackState
+
+
+def _estimate(index: int, state: TrackState = TrackState.TRACKING) -> TargetEstimate:
+    return TargetEstimate((20.0 + index, 30.0, 40.0, 50.0), (0.0, 0.0), 0.9, state, index / 30, index)
+
+
+def test_annotate_draws_box_in_the_state_colour_without_touching_the_input() -> None:
+    image = np.zeros((240, 320, 3), np.uint8)
+    estimate = TargetEstimate((200.0, 150.0, 60.0, 50.0), (0.0, 0.0), 0.2, TrackState.LOST, 0.0, 0)
+    out = annotate(image, estimate, rates_dps=(12.0, -3.5), lines=["extra"])
+    assert not image.any()
+    assert tuple(out[175, 200]) == STATE_COLOURS[TrackState.LOST]  # left edge of the box
+    assert tuple(out[200, 230]) == STATE_COLOURS[TrackState.LOST]  # bottom edge
+    assert tuple(out[175, 230]) == STATE_COLOURS[TrackState.LOST]  # subject centre cross
+    assert out[140, 185].any()  # on the error vector from (160, 120) to (230, 175)
+    assert out[10:60, 10:100].any()  # the text block
+
+
+def test_video_reads_back_with_every_frame(tmp_path: Path, frame_image: Callable[..., np.ndarray]) -> None:
+    path = tmp_path / "annotated.mp4"
+    with AnnotatedVideoWriter(path, (160, 120), 30.0) as writer:
+        for index in range(15):
+            estimate = _estimate(index) if index % 3 else None
+            writer.write(frame_image(index, (160, 120)), estimate, (1.0, 2.0) if estimate else None)
+        assert writer.frames == 15
+    with open_source(str(path)) as source:
+        assert source.size == (160, 120) and source.fps == 30.0
+        assert len(list(source)) == 15
+
+
+def test_wrong_frame_size_and_unknown_container_are_refused(tmp_path: Path) -> None:
+    with AnnotatedVideoWriter(tmp_path / "a.mp4", (160, 120), 30.0) as writer:
+        with pytest.raises(ValueError, match="frame is 80x60, video is 160x120"):
+            writer.write(np.zeros((60, 80, 3), np.uint8))
+    with pytest.raises(ValueError, match="must end in .mp4 or .avi"):
+        AnnotatedVideoWriter(tmp_path / "a.mkv", (160, 120), 30.0)
+    with pytest.raises(OSError, match="cannot write video"):
+        AnnotatedVideoWriter(tmp_path / "missing" / "a.mp4", (160, 120), 30.0)
+
+
+def test_avi_stays_readable_when_the_process_dies(tmp_path: Path, run_and_crash: Callable[[str], None]) -> None:
+    path = tmp_path / "annotated.avi"
+    run_and_crash(f"""
+        import numpy as np
+        from pipelines.outputs.annotated_video import AnnotatedVideoWriter
+        writer = AnnotatedVideoWriter({str(path)!r}, (160, 120), 30.0)
+        rng = np.random.default_rng(0)
+        for _ in range(60):
+            writer.write(rng.integers(0, 256, (120, 160, 3), dtype=np.uint8))
+    """)
+    capture = cv2.VideoCapture(str(path))
+    count = 0
+    while capture.read()[0]:
+        count += 1
+    assert count >= 50  # all but what was still in FFmpeg's write buffer
