@@ -13,9 +13,10 @@ class SourceError(Exception):
     """A source cannot be opened or stopped delivering frames; the message is one line."""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Frame:
-    """One BGR image, its capture time in seconds and its position in the source's sequence."""
+    """One BGR image, its capture time in seconds and its position in the source's sequence
+    (compared by identity: the image is an array)."""
 
     image: np.ndarray
     timestamp: float
