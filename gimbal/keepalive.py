@@ -1,0 +1,192 @@
+"""The speed keep-alive: one speed command lasts 0.5 s on the gimbal, so the latest setpoint is
+resent at a fixed rate from a background thread.
+
+Replies are not waited for synchronously: each send is a reply-required speed command whose
+reply is checked at the next send (at least half a period later, 20 ms at 25 Hz, against replies
+that arrive within ~5 ms), so a slow or silent gimbal never lowers the send rate. A new setpoint
+is sent at once (if half a period has passed since the last send) instead of waiting for the
+next tick, which keeps the capture-to-command latency low; the schedule restarts from there.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import can
+
+from gimbal.client import SPEED_HOLD, GimbalClient, PendingReply
+from gimbal.errors import BusError, GimbalError, RangeError
+from gimbal.messages.motion import SpeedControl
+
+log = logging.getLogger(__name__)
+
+MAX_SPEED_DPS = 360.0
+MIN_RATE_HZ = 4.0  # at least two sends inside the gimbal's 0.5 s window
+
+
+@dataclass
+class _Setpoint:
+    yaw: int  # 0.1 °/s
+    roll: int
+    pitch: int
+    set_at: float
+    stamp: float
+    sent: bool = False
+
+
+def _clamped_raw(value: float, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
+        raise RangeError(f"{name}={value!r} is not a number")
+    return round(max(-MAX_SPEED_DPS, min(MAX_SPEED_DPS, value)) * 10)
+
+
+class SpeedStreamer:
+    """Streams the latest yaw/pitch/roll speed setpoint at ``rate_hz``.
+
+    A setpoint older than ``max_age`` seconds (since ``set()``, on ``clock``) is never resent:
+    zero speed goes out instead, so a stalled tracker stops the gimbal. Reply errors and timeouts
+    are counted in ``stats``; a refused send (``can.CanError``) or ``max_missed_replies``
+    consecutive reply timeouts mean the bus (or gimbal) is lost: streaming stops, a best-effort
+    stop is sent, ``error`` is set and the next ``set()`` raises ``BusError``.
+    """
+
+    def __init__(self, client: GimbalClient, rate_hz: float = 25.0, max_age: float = 0.3, *,
+                 max_missed_replies: int = 10, clock: Callable[[], float] = time.monotonic) -> None:
+        if not rate_hz >= MIN_RATE_HZ:
+            raise ValueError(f"rate_hz must be at least {MIN_RATE_HZ} (a command lasts 0.5 s)")
+        if not max_age > 0 or max_missed_replies < 1:
+            raise ValueError("max_age must be > 0 and max_missed_replies >= 1")
+        self.rate_hz = rate_hz
+        self.max_age = max_age
+        self.max_missed_replies = max_missed_replies
+        self.stats: Counter[str] = Counter()  # sent, zero_sent, replies, reply_errors, reply_timeouts
+        self.error: BaseException | None = None
+        self._client = client
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._setpoint: _Setpoint | None = None
+        self._latencies: list[float] = []
+        self._missed = 0
+        self._halt = threading.Event()
+        self._wake = threading.Event()  # a new setpoint: send it now rather than at the next tick
+        self._stopped = False
+        self._thread = threading.Thread(target=self._run, name="gimbal-speed", daemon=True)
+        self._thread.start()
+
+    @property
+    def running(self) -> bool:
+        return self._thread.is_alive() and not self._halt.is_set()
+
+    def set(self, yaw_dps: float, pitch_dps: float, roll_dps: float = 0.0,
+            stamp: float | None = None) -> None:
+        """New setpoint in °/s, clamped to ±360. ``stamp`` is the capture time of the frame it
+        came from (same clock; default now), for ``latencies()``."""
+        if self.error is not None:
+            raise BusError(f"speed streaming stopped: {self.error}") from self.error
+        if self._stopped:
+            raise GimbalError("the speed streamer is stopped")
+        now = self._clock()
+        setpoint = _Setpoint(_clamped_raw(yaw_dps, "yaw_dps"), _clamped_raw(roll_dps, "roll_dps"),
+                             _clamped_raw(pitch_dps, "pitch_dps"), now, now if stamp is None else stamp)
+        with self._lock:
+            self._setpoint = setpoint
+        self._wake.set()
+
+    def latencies(self) -> list[float]:
+        """Seconds from each setpoint's ``stamp`` to its first send on the bus."""
+        with self._lock:
+            return list(self._latencies)
+
+    def stop(self) -> None:
+        """Stop streaming, then send zero speed and release control (bit 7 clear). Idempotent."""
+        if self._stopped:
+            return
+        self._stopped = True
+        self._halt.set()
+        self._wake.set()
+        if self._thread is not threading.current_thread():
+            self._thread.join()
+        self._client.stop_and_release()
+
+    def halt(self, error: BaseException) -> None:
+        """Stop streaming because the bus is lost (called by the client; does not block)."""
+        self.error = self.error or error
+        self._halt.set()
+        self._wake.set()
+
+    def _run(self) -> None:
+        period = 1.0 / self.rate_hz
+        min_gap = period / 2
+        pending: PendingReply | None = None
+        next_tick = last_send = time.monotonic() - period
+        try:
+            while not self._halt.is_set():
+                now = time.monotonic()
+                early = self._wake.is_set() and now - last_send >= min_gap
+                if now >= next_tick or early:
+                    self._wake.clear()
+                    self._collect(pending)
+                    pending = self._tick()
+                    last_send = now
+                    behind = next_tick + period <= now  # fell behind: do not burst to catch up
+                    next_tick = now + period if early or behind else next_tick + period
+                elif self._wake.is_set():  # a new setpoint, but too soon after the last send
+                    self._halt.wait(last_send + min_gap - now)
+                else:
+                    self._wake.wait(next_tick - now)
+        except (GimbalError, can.CanError) as exc:
+            if self._halt.is_set():
+                return  # stop() or halt() raced with a send: nothing is lost
+            self.error = exc
+            self._halt.set()
+            log.error("speed streaming stopped: %s", exc)
+            self._client.stop_and_release()
+        finally:
+            if pending is not None:
+                self._client.cancel(pending)
+
+    def _tick(self) -> PendingReply:
+        now = self._clock()
+        with self._lock:
+            setpoint = self._setpoint
+            fresh = setpoint is not None and now - setpoint.set_at <= self.max_age
+        if fresh:
+            assert setpoint is not None
+            message = SpeedControl(setpoint.yaw, setpoint.roll, setpoint.pitch, SPEED_HOLD)
+        else:
+            message = SpeedControl(0, 0, 0, SPEED_HOLD)
+        pending = self._client.submit(message)
+        self.stats["sent"] += 1
+        if not fresh:
+            self.stats["zero_sent"] += 1
+        elif not setpoint.sent:
+            setpoint.sent = True
+            with self._lock:
+                self._latencies.append(self._clock() - setpoint.stamp)
+        return pending
+
+    def _collect(self, pending: PendingReply | None) -> None:
+        """Account for the previous tick's reply; too many missing in a row = bus lost."""
+        if pending is None:
+            return
+        self._client.cancel(pending)
+        if not pending.done:
+            self.stats["reply_timeouts"] += 1
+            self._missed += 1
+            if self._missed >= self.max_missed_replies:
+                raise BusError(f"no reply to {self._missed} consecutive speed commands")
+            return
+        self._missed = 0
+        try:
+            self._client.result(pending)
+            self.stats["replies"] += 1
+        except BusError:
+            raise
+        except GimbalError as exc:  # a NACK or an undecodable reply: counted, streaming goes on
+            self.stats["reply_errors"] += 1
+            log.warning("speed command reply: %s", exc)

@@ -1,0 +1,85 @@
+"""Device pushes (parameter push, calibration status): latest value, callbacks and waiting."""
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable
+from typing import TypeVar
+
+from gimbal.errors import GimbalTimeoutError
+from gimbal.messages import Kind, Message, Sender
+
+log = logging.getLogger(__name__)
+
+M = TypeVar("M", bound=Message)
+PushCallback = Callable[[M, float], None]
+
+
+def _check_push_class(cls: type[Message]) -> None:
+    if getattr(cls, "KIND", None) is not Kind.PUSH or getattr(cls, "SENDER", None) is not Sender.DEVICE:
+        raise ValueError(f"{getattr(cls, '__name__', cls)!r} is not a push the gimbal sends "
+                         "(e.g. ParameterPush, CalibrationStatusPush)")
+
+
+class PushHub:
+    """Keeps the latest push of each class with its arrival time (``time.monotonic()``) and calls
+    subscribers. A subscriber that raises is logged and stays subscribed."""
+
+    def __init__(self) -> None:
+        self._cond = threading.Condition()
+        self._latest: dict[type[Message], tuple[Message, float]] = {}
+        self._counts: Counter[type[Message]] = Counter()
+        self._callbacks: dict[type[Message], list[PushCallback]] = {}
+
+    def subscribe(self, cls: type[M], callback: PushCallback[M]) -> Callable[[], None]:
+        """Call ``callback(msg, t)`` for every ``cls`` push; returns a function that unsubscribes."""
+        _check_push_class(cls)
+        with self._cond:
+            self._callbacks.setdefault(cls, []).append(callback)
+
+        def unsubscribe() -> None:
+            with self._cond:
+                callbacks = self._callbacks.get(cls, [])
+                if callback in callbacks:
+                    callbacks.remove(callback)
+        return unsubscribe
+
+    def deliver(self, message: Message, t: float) -> None:
+        """Record one push and run its subscribers (on the caller's thread)."""
+        cls = type(message)
+        with self._cond:
+            self._latest[cls] = (message, t)
+            self._counts[cls] += 1
+            callbacks = list(self._callbacks.get(cls, ()))
+            self._cond.notify_all()
+        for callback in callbacks:
+            try:
+                callback(message, t)
+            except Exception:  # a user's bug must not stop the receive thread
+                log.exception("push callback %r failed on %s", callback, message.NAME)
+
+    def latest(self, cls: type[M]) -> tuple[M, float] | None:
+        """The newest ``cls`` push and its arrival time, or None if none arrived yet."""
+        _check_push_class(cls)
+        with self._cond:
+            return self._latest.get(cls)  # type: ignore[return-value]
+
+    def count(self, cls: type[Message]) -> int:
+        """How many ``cls`` pushes arrived so far."""
+        with self._cond:
+            return self._counts[cls]
+
+    def wait(self, cls: type[M], timeout: float) -> tuple[M, float]:
+        """The next ``cls`` push to arrive after this call; ``GimbalTimeoutError`` after ``timeout`` s."""
+        _check_push_class(cls)
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            seen = self._counts[cls]
+            while self._counts[cls] == seen:
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise GimbalTimeoutError(f"no {cls.NAME} within {timeout:g} s")
+                self._cond.wait(remaining)
+            return self._latest[cls]  # type: ignore[return-value]
