@@ -39,8 +39,11 @@ class PacketFramer:
         return out
 
     def flush(self) -> list[Dropped]:
-        """End of stream: whatever is left is a truncated packet."""
-        return [self._drop("truncated", len(self._buffer))] if self._buffer else []
+        """End of stream: whatever is left is truncated (one drop per packet start found in it)."""
+        out = []
+        while self._buffer:
+            out.append(self._drop("truncated", self._next_start(1, len(self._buffer)) or len(self._buffer)))
+        return out
 
     @property
     def pending(self) -> int:
@@ -66,18 +69,23 @@ class PacketFramer:
             return False
         length = declared_length(buf)
         if length < MIN_PACKET_LEN:
-            out.append(self._drop("length", 1))
+            out.append(self._drop("length", self._next_sof(1)))
             return True
         if len(buf) < HEADER_LEN:
             return False
         if crc16(bytes(buf[:10])) != int.from_bytes(buf[10:12], "little"):
-            out.append(self._drop("crc16", 1))
+            out.append(self._drop("crc16", self._next_sof(1)))
             return True
         if len(buf) < length:
+            cut = self._complete_packet_inside(len(buf))
+            if cut:  # a whole packet already follows: this one lost its tail
+                out.append(self._drop("truncated", cut))
+                return True
             return False
         raw = bytes(buf[:length])
         if crc32(raw[:-4]) != int.from_bytes(raw[-4:], "little"):
-            out.append(self._drop("crc32", 1))  # resync at the next SOF inside this span
+            cut = self._next_start(1, length)  # a packet starting inside means this one was cut short
+            out.append(self._drop("truncated", cut) if cut else self._drop("crc32", length))
             return True
         try:
             packet = decode_packet(raw)
@@ -88,3 +96,39 @@ class PacketFramer:
         self.stats["packets"] += 1
         out.append(packet)
         return True
+
+    def _next_sof(self, start: int) -> int:
+        """Offset of the next SOF at or after ``start``, or the buffer length."""
+        found = self._buffer.find(SOF, start)
+        return found if found >= 0 else len(self._buffer)
+
+    def _header_at(self, offset: int) -> bool | None:
+        """Whether a valid header (length and CRC16) starts at ``offset``; None: not all here yet."""
+        buf = self._buffer
+        if len(buf) - offset < HEADER_LEN:
+            return None
+        return declared_length(buf[offset:offset + 3]) >= MIN_PACKET_LEN and \
+            crc16(bytes(buf[offset:offset + 10])) == int.from_bytes(buf[offset + 10:offset + 12], "little")
+
+    def _next_start(self, start: int, end: int) -> int:
+        """First offset in ``start..end-1`` where a packet may start (valid or incomplete header);
+        0 when there is none."""
+        offset = self._buffer.find(SOF, start, end)
+        while offset >= 0:
+            if self._header_at(offset) is not False:
+                return offset
+            offset = self._buffer.find(SOF, offset + 1, end)
+        return 0
+
+    def _complete_packet_inside(self, end: int) -> int:
+        """Offset (> 0, < ``end``) of a whole packet with both CRCs valid; 0 when there is none."""
+        buf = self._buffer
+        offset = buf.find(SOF, 1, end)
+        while offset >= 0:
+            if self._header_at(offset):
+                length = declared_length(buf[offset:offset + 3])
+                if offset + length <= len(buf) and crc32(bytes(buf[offset:offset + length - 4])) == \
+                        int.from_bytes(buf[offset + length - 4:offset + length], "little"):
+                    return offset
+            offset = buf.find(SOF, offset + 1, end)
+        return 0

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import struct
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from gimbal.crc import crc16, crc32
 
@@ -33,13 +33,15 @@ class PacketError(ValueError):
 @dataclass(frozen=True, slots=True)
 class Packet:
     """One packet. ``data`` is the DATA field: CmdSet, CmdID and payload (a legacy reply omits
-    CmdSet/CmdID and starts with the return code)."""
+    CmdSet/CmdID and starts with the return code). ``raw`` holds the bytes it was decoded from
+    (empty for packets built here); it takes no part in comparisons."""
 
     cmd_type: int
     seq: int
     data: bytes
     enc: int = 0
     version: int = 0
+    raw: bytes = field(default=b"", compare=False, repr=False)
 
     @classmethod
     def command(cls, cmd_set: int, cmd_id: int, payload: bytes, seq: int,
@@ -95,6 +97,10 @@ def encode_packet(packet: Packet) -> bytes:
         raise PacketError("length", f"packet of {length} bytes exceeds the 10-bit length field")
     if not 0 <= packet.seq <= 0xFFFF:
         raise PacketError("seq", f"SEQ {packet.seq} is outside 0..0xFFFF")
+    if not 0 <= packet.version <= 0x3F:
+        raise PacketError("version", f"version {packet.version} does not fit the 6-bit field")
+    if not packet.data:
+        raise PacketError("length", "a packet carries at least one DATA byte")
     head = _HEADER.pack(SOF, (packet.version << 10) | length, packet.cmd_type & 0xFF,
                         packet.enc & 0xFF, b"\x00\x00\x00", packet.seq)
     body = head + crc16(head).to_bytes(2, "little") + packet.data
@@ -126,5 +132,6 @@ def decode_packet(raw: bytes) -> Packet:
     if enc >> 5:
         raise PacketError("encrypted", f"encrypted packet (ENC 0x{enc:02X}) is not supported: "
                                        "the document specifies no key")
-    return Packet(cmd_type=cmd_type, seq=seq, data=bytes(raw[HEADER_LEN:-4]), enc=enc,
-                  version=ver_len >> 10)
+    raw = bytes(raw)
+    return Packet(cmd_type=cmd_type, seq=seq, data=raw[HEADER_LEN:-4], enc=enc, version=ver_len >> 10,
+                  raw=raw)

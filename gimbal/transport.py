@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import threading
 import time
+import weakref
 from collections import deque
 
 import can
@@ -13,6 +14,19 @@ from gimbal.packet import Packet, encode_packet
 HOST_TX_ID = 0x223  # the host sends here; the gimbal listens here
 HOST_RX_ID = 0x222  # the gimbal answers here
 CAN_FRAME_DATA = 8
+
+_BUS_LOCKS: weakref.WeakKeyDictionary[can.BusABC, threading.Lock] = weakref.WeakKeyDictionary()
+_BUS_LOCKS_GUARD = threading.Lock()
+
+
+def bus_send_lock(bus: can.BusABC) -> threading.Lock:
+    """The one lock every transport on ``bus`` holds while it sends a packet's frames, so two
+    transports (e.g. a client and a keep-alive) sharing a bus object never interleave."""
+    with _BUS_LOCKS_GUARD:
+        lock = _BUS_LOCKS.get(bus)
+        if lock is None:
+            lock = _BUS_LOCKS[bus] = threading.Lock()
+        return lock
 
 
 def packet_frames(raw: bytes, arbitration_id: int) -> list[can.Message]:
@@ -37,7 +51,7 @@ class CanTransport:
         self.send_timeout = send_timeout
         self.framer = PacketFramer()
         self.foreign_frames = 0
-        self._send_lock = threading.Lock()
+        self._send_lock = bus_send_lock(bus)
         self._ready: deque[Packet | Dropped] = deque()
 
     def send(self, packet: Packet | bytes) -> bytes:

@@ -17,6 +17,8 @@ from gimbal.packet import NO_REPLY, REPLY_REQUIRED, Packet
 
 
 def _pick(candidates: list[type[Message]], payload: bytes, what: str) -> type[Message]:
+    if len(candidates) == 1:
+        return candidates[0]
     for cls in candidates:
         if cls.matches(payload):
             return cls
@@ -38,15 +40,15 @@ def decode_message(packet: Packet, request: type[Message] | Message | None = Non
     """
     data = packet.data
     key = (data[0], data[1]) if len(data) >= 2 else None
-    if key in DEVICE_PUSHES:
-        cls = _pick(DEVICE_PUSHES[key], data[2:], f"push 0x{key[0]:02X}/0x{key[1]:02X}")
-        return cls.decode_payload(data[2:])
+    pushes = DEVICE_PUSHES.get(key) if key is not None else None
+    if pushes is not None:
+        return _pick(pushes, data[2:], f"push 0x{key[0]:02X}/0x{key[1]:02X}").decode_payload(data[2:])
     if packet.is_reply:
         return _decode_reply(packet, request)
-    if key is None or key not in HOST_MESSAGES:
-        raise UnknownMessageError(f"command {data[:2].hex(' ')} is not defined by the document")
-    cls = _pick(HOST_MESSAGES[key], data[2:], f"command 0x{key[0]:02X}/0x{key[1]:02X}")
-    return cls.decode_payload(data[2:])
+    candidates = HOST_MESSAGES.get(key) if key is not None else None
+    if candidates is None:
+        raise UnknownMessageError(f"command {data[:2].hex(' ') or '(empty)'} is not defined by the document")
+    return _pick(candidates, data[2:], f"command 0x{key[0]:02X}/0x{key[1]:02X}").decode_payload(data[2:])
 
 
 def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Message:
@@ -54,6 +56,8 @@ def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Me
         if request is None:
             raise UnknownMessageError("legacy-layout reply (no CmdSet/CmdID) without the command it answers")
         key, payload = (request.CMD_SET, request.CMD_ID), packet.data
+    elif len(packet.data) < 2:
+        raise PayloadError(f"reply data {packet.data.hex(' ')} is too short for CmdSet/CmdID")
     else:
         key, payload = (packet.data[0], packet.data[1]), packet.data[2:]
     expected = getattr(request, "REPLY", None)

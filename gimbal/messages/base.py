@@ -50,24 +50,29 @@ class Message:
 
     def encode_payload(self) -> bytes:
         """The payload bytes (after CmdSet/CmdID); validates first."""
-        self.validate()
-        values = self.values()
+        layout = _layout(type(self))
+        values = [getattr(self, name) for name in layout.names]
+        self._check(layout, values)
         if self.PARTIAL and None in values:  # e.g. a NACK reply carrying its return code alone
-            values = values[:values.index(None)]
-        return struct.pack("<" + self.FORMAT[:len(values)], *values)
+            present = values.index(None)
+            return struct.pack("<" + self.FORMAT[:present], *values[:present])
+        return layout.struct.pack(*values)
 
     @classmethod
     def decode_payload(cls, payload: bytes) -> Self:
         """Parse a payload; extra trailing bytes are ignored, missing ones raise (or are None if
         ``PARTIAL``)."""
+        layout = _layout(cls)
+        if len(payload) >= layout.struct.size:
+            return cls(*layout.struct.unpack_from(payload))
         values: list[int | None] = []
         offset = 0
         for code in cls.FORMAT:
-            size = struct.calcsize("<" + code)
+            size = _CODE_SIZES[code]
             if offset + size > len(payload):
                 if not (cls.PARTIAL and values):
                     raise PayloadError(f"{cls.NAME}: payload of {len(payload)} bytes is shorter than "
-                                       f"the {struct.calcsize('<' + cls.FORMAT)} the document defines")
+                                       f"the {layout.struct.size} the document defines")
                 values.append(None)
                 continue
             values.append(struct.unpack_from("<" + code, payload, offset)[0])
@@ -84,23 +89,52 @@ class Message:
 
     def validate(self) -> None:
         """Raise ``RangeError`` for any field outside the document's range."""
-        for field, code in zip(dataclasses.fields(self), self.FORMAT):
-            value = getattr(self, field.name)
+        layout = _layout(type(self))
+        self._check(layout, [getattr(self, name) for name in layout.names])
+
+    def _check(self, layout: _Layout, values: list[Any]) -> None:
+        missing = False
+        for (name, low, high, allowed), value in zip(layout.checks, values):
             if value is None and self.PARTIAL:
+                missing = True
                 continue
-            if not isinstance(value, int) or isinstance(value, bool):
-                raise RangeError(f"{self.NAME}.{field.name} must be an integer, not {value!r}")
-            low, high = self.RANGES.get(field.name, _TYPE_RANGES[code])
+            if missing:
+                raise RangeError(f"{self.NAME}.{name} is set but an earlier field is missing: "
+                                 "only trailing fields may be left out")
+            if value.__class__ is not int and (not isinstance(value, int) or isinstance(value, bool)):
+                raise RangeError(f"{self.NAME}.{name} must be an integer, not {value!r}")
             if not low <= value <= high:
-                raise RangeError(f"{self.NAME}.{field.name}={value} is outside {low}..{high}")
-            allowed = self.CHOICES.get(field.name)
+                raise RangeError(f"{self.NAME}.{name}={value} is outside {low}..{high}")
             if allowed is not None and value not in allowed:
                 listed = ", ".join(f"0x{v:02X}" for v in sorted(allowed))
-                raise RangeError(f"{self.NAME}.{field.name}=0x{value:02X} is not one of {listed}")
+                raise RangeError(f"{self.NAME}.{name}=0x{value:02X} is not one of {listed}")
 
     def fields(self) -> dict[str, Any]:
         """The fields as JSON-friendly values (bytes as hex)."""
         return {f.name: _jsonable(getattr(self, f.name)) for f in dataclasses.fields(self)}
+
+
+_CODE_SIZES = {code: struct.calcsize("<" + code) for code in _TYPE_RANGES}
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class _Layout:
+    """What encoding and decoding a fixed-layout class needs, computed once per class."""
+
+    names: tuple[str, ...]
+    struct: struct.Struct
+    checks: tuple[tuple[str, int, int, frozenset[int] | None], ...]
+
+
+def _layout(cls: type[Message]) -> _Layout:
+    layout = cls.__dict__.get("_LAYOUT")
+    if layout is None:
+        names = tuple(f.name for f in dataclasses.fields(cls))[:len(cls.FORMAT)]
+        checks = tuple((name, *cls.RANGES.get(name, _TYPE_RANGES[code]), cls.CHOICES.get(name))
+                       for name, code in zip(names, cls.FORMAT))
+        layout = _Layout(names, struct.Struct("<" + cls.FORMAT), checks)
+        cls._LAYOUT = layout  # type: ignore[attr-defined]  # cached on the class itself
+    return layout
 
 
 def _jsonable(value: Any) -> Any:

@@ -99,6 +99,8 @@ class FocusCalibrationReply(Reply):
     CMD_ID: ClassVar[int] = 0x12
     NAME: ClassVar[str] = "focus_calibration_reply"
     FORMAT: ClassVar[str] = "BBBB"
+    CHOICES: ClassVar = {"sub_id": frozenset({FOCUS_CALIBRATION}), "motor_type": frozenset({FOCUS_MOTOR}),
+                         "result": frozenset({0x00, 0x01})}
     return_code: int = 0
     sub_id: int | None = FOCUS_CALIBRATION
     motor_type: int | None = FOCUS_MOTOR
@@ -140,7 +142,8 @@ class FocusPositionReply(Reply):
     NAME: ClassVar[str] = "focus_position_reply"
     FORMAT: ClassVar[str] = "BBBBI"
     RANGES: ClassVar = {"position": FOCUS_POSITION_RANGE}
-    CHOICES: ClassVar = {"calibration_state": frozenset(FOCUS_CALIBRATION_STATES)}
+    CHOICES: ClassVar = {"sub_id": frozenset({FOCUS_POSITION_QUERY}), "motor_type": frozenset({FOCUS_MOTOR}),
+                         "calibration_state": frozenset(FOCUS_CALIBRATION_STATES)}
     return_code: int = 0
     sub_id: int | None = FOCUS_POSITION_QUERY
     motor_type: int | None = FOCUS_MOTOR

@@ -236,8 +236,9 @@ class CalibrationStatusPush(DevicePush):
 
     def validate(self) -> None:
         status = self._status_value()
-        if status is None:
+        if status is None or len(status) != CALIBRATION_STATUS_LENGTH:
             raise RangeError(f"{self.NAME}: needs TLV 0x00 of {CALIBRATION_STATUS_LENGTH} bytes")
+        encode_tlvs(self.tlvs)
         if status[0] not in CALIBRATION_STATES or status[1] > 100:
             raise RangeError(f"{self.NAME}: state {status[0]} / progress {status[1]} out of range")
 
