@@ -1,0 +1,96 @@
+"""Fault injection: lost, corrupted and delayed frames, NACKs, silence, legacy replies, foreign
+traffic. One seeded RNG makes every run reproducible."""
+from __future__ import annotations
+
+import random
+from collections import Counter
+from dataclasses import dataclass
+
+DIRECTIONS = ("both", "rx", "tx")
+FOREIGN_IDS = (0x530, 0x531, 0x426)  # DJI's internal accessory traffic seen on live buses
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Which faults to inject; the defaults inject none."""
+
+    drop: float = 0.0  # fraction of CAN frames lost
+    corrupt: float = 0.0  # fraction of CAN frames with one byte altered
+    direction: str = "both"  # where drop/corrupt apply: "rx" (host -> sim), "tx" or "both"
+    delay_s: float = 0.0  # every reply leaves this much later
+    nack: float = 0.0  # fraction of commands refused (not executed) with ``nack_code``
+    nack_code: int = 0x02
+    silent: tuple[float, float] | None = None  # (start, end) s after start(): deaf and mute
+    legacy: float = 0.0  # fraction of replies in the legacy layout whatever the firmware mode
+    foreign_rate: float = 0.0  # foreign frames per second added to the bus
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("drop", "corrupt", "nack", "legacy"):
+            value = getattr(self, name)
+            if not 0.0 <= value <= 1.0:
+                raise ValueError(f"Faults.{name} is a fraction in 0..1, not {value}")
+        if self.direction not in DIRECTIONS:
+            raise ValueError(f"Faults.direction must be one of {', '.join(DIRECTIONS)}, not {self.direction!r}")
+        if self.delay_s < 0 or self.foreign_rate < 0:
+            raise ValueError("Faults.delay_s and Faults.foreign_rate cannot be negative")
+        if not 0 <= self.nack_code <= 0xFF:
+            raise ValueError(f"Faults.nack_code {self.nack_code} does not fit a byte")
+        if self.silent is not None and not 0 <= self.silent[0] <= self.silent[1]:
+            raise ValueError(f"Faults.silent {self.silent} must be (start, end) with 0 <= start <= end")
+
+
+class FaultInjector:
+    """Applies ``Faults`` frame by frame and counts what it did (``counts``)."""
+
+    def __init__(self, faults: Faults) -> None:
+        self.faults = faults
+        self.counts: Counter[str] = Counter()
+        self._rng = random.Random(faults.seed)
+        self._foreign_due = 0.0
+
+    def silent(self, elapsed: float) -> bool:
+        window = self.faults.silent
+        return window is not None and window[0] <= elapsed < window[1]
+
+    def frame(self, data: bytes, direction: str) -> bytes | None:
+        """A frame's data after loss and corruption (None: lost) for ``direction`` rx or tx."""
+        if self.faults.direction not in ("both", direction):
+            return data
+        if self.faults.drop and self._rng.random() < self.faults.drop:
+            self.counts[f"dropped_{direction}"] += 1
+            return None
+        if self.faults.corrupt and data and self._rng.random() < self.faults.corrupt:
+            self.counts[f"corrupted_{direction}"] += 1
+            index = self._rng.randrange(len(data))
+            altered = bytearray(data)
+            altered[index] ^= self._rng.randrange(1, 256)
+            return bytes(altered)
+        return data
+
+    def nack(self) -> int | None:
+        """The return code to refuse this command with, or None to execute it."""
+        if self.faults.nack and self._rng.random() < self.faults.nack:
+            self.counts["nacks"] += 1
+            return self.faults.nack_code
+        return None
+
+    def legacy_reply(self) -> bool:
+        if self.faults.legacy and self._rng.random() < self.faults.legacy:
+            self.counts["legacy_replies"] += 1
+            return True
+        return False
+
+    def foreign_frames(self, dt: float) -> list[tuple[int, bytes]]:
+        """The foreign (id, data) frames due over ``dt`` seconds: 0x55-led packets cut in 8-byte
+        pieces and random bytes, on DJI's accessory ids."""
+        self._foreign_due += self.faults.foreign_rate * dt
+        count, self._foreign_due = int(self._foreign_due), self._foreign_due % 1.0
+        frames = []
+        for _ in range(count):
+            data = bytearray(self._rng.randbytes(self._rng.randint(1, 8)))
+            if self._rng.random() < 0.5:
+                data[0] = 0x55
+            frames.append((self._rng.choice(FOREIGN_IDS), bytes(data)))
+        self.counts["foreign_sent"] += len(frames)
+        return frames
