@@ -11,6 +11,7 @@ from pipelines.cli.common import CliError
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
 SUBCOMMAND_MODULES = [
     "pipelines.cli.decode_cmd",
+    "pipelines.cli.sim_cmd",
 ]
 
 

@@ -1,0 +1,169 @@
+"""``gimbaltrack sim``: run the simulated DJI RS gimbal on a CAN bus (e.g. udp_multicast between
+processes), printing its state once a second, until Ctrl-C, SIGTERM or --duration."""
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import threading
+import time
+from types import FrameType
+from typing import Any
+
+import can
+
+from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
+from gimbal.sim.faults import DIRECTIONS
+from pipelines.cli.common import CliError, add_bus_options, parse_int
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "sim", help="run the simulated DJI RS gimbal on a CAN bus",
+        description="A protocol-complete simulated DJI RS gimbal: answers every DJI R SDK command on "
+        "the bus like the real device, with an axis model and optional fault injection. Run it on "
+        "udp_multicast and drive it from another process, e.g. "
+        "'gimbaltrack sim -i udp_multicast -c 239.74.163.2'. The id options keep the host's point of "
+        "view: the simulator listens on --tx-id and answers on --rx-id.")
+    add_bus_options(parser, default_interface="udp_multicast")
+    model = parser.add_argument_group("device")
+    model.add_argument("--legacy", action="store_true", help="old firmware: replies omit CmdSet/CmdID")
+    model.add_argument("--push-rate", type=float, default=SimConfig.push_rate_hz, metavar="HZ",
+                       help="parameter push rate once enabled (default %(default)s)")
+    model.add_argument("--accel", type=float, default=SimConfig.accel_dps2, metavar="DPS2",
+                       help="axis acceleration limit in °/s² (default %(default)s)")
+    model.add_argument("--base-yaw", type=float, default=SimConfig.base_yaw_deg, metavar="DEG",
+                       help="attitude yaw minus joint yaw (default %(default)s)")
+    model.add_argument("--yaw-continuous", action="store_true",
+                       help="yaw wraps at ±180° and ignores the yaw limits (default: stops at the limits)")
+    model.add_argument("--version", type=_version, default=SimConfig.version, metavar="AA.BB.CC.DD",
+                       help="version answered to 0x0E/0x09 (default 02.05.00.00)")
+    model.add_argument("--calibration-time", type=float, default=SimConfig.calibration_s, metavar="S",
+                       help="auto-calibration duration (default %(default)s)")
+    model.add_argument("--no-camera", action="store_true", help="no camera: camera commands fail (0x02)")
+    faults = parser.add_argument_group("faults")
+    faults.add_argument("--drop", type=float, default=0.0, metavar="FRACTION", help="lose CAN frames")
+    faults.add_argument("--corrupt", type=float, default=0.0, metavar="FRACTION",
+                        help="alter one byte of CAN frames")
+    faults.add_argument("--fault-direction", choices=DIRECTIONS, default="both",
+                        help="where --drop/--corrupt apply: rx (host to sim), tx or both (default)")
+    faults.add_argument("--delay-ms", type=float, default=0.0, metavar="MS", help="delay every reply")
+    faults.add_argument("--nack", type=float, default=0.0, metavar="FRACTION",
+                        help="refuse this fraction of commands with --nack-code")
+    faults.add_argument("--nack-code", type=parse_int, default=0x02, help="return code of refusals (default 0x02)")
+    faults.add_argument("--silent", type=_window, metavar="START:END",
+                        help="neither hear nor send between these seconds after start")
+    faults.add_argument("--legacy-fraction", type=float, default=0.0, metavar="FRACTION",
+                        help="send this fraction of replies in the legacy layout")
+    faults.add_argument("--foreign-rate", type=float, default=0.0, metavar="HZ",
+                        help="add foreign frames (0x530/0x531/0x426, 0x55 packets) at this rate")
+    faults.add_argument("--seed", type=int, default=0, help="fault RNG seed (default 0)")
+    run_group = parser.add_argument_group("run")
+    run_group.add_argument("--duration", type=float, metavar="S", help="stop after this many seconds")
+    run_group.add_argument("--status-interval", type=float, default=1.0, metavar="S",
+                           help="print the state every S seconds (default 1; 0: never)")
+    run_group.add_argument("--json", action="store_true", help="print the full state as JSON lines")
+    parser.set_defaults(func=run)
+
+
+def _version(text: str) -> int:
+    """AA.BB.CC.DD (hex bytes, the document's notation) or a plain integer."""
+    parts = text.split(".")
+    try:
+        if len(parts) == 4:
+            values = [int(p, 16) for p in parts]
+            if all(0 <= v <= 0xFF for v in values):
+                return int.from_bytes(bytes(values), "big")
+        elif len(parts) == 1 and 0 <= (value := int(text, 0)) <= 0xFFFFFFFF:
+            return value
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(f"not a version AA.BB.CC.DD or 32-bit integer: {text!r}")
+
+
+def _window(text: str) -> tuple[float, float]:
+    start, sep, end = text.partition(":")
+    try:
+        window = (float(start), float(end))
+    except ValueError:
+        window = None
+    if not sep or window is None or not 0 <= window[0] <= window[1]:
+        raise argparse.ArgumentTypeError(f"not a window START:END in seconds with START <= END: {text!r}")
+    return window
+
+
+def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
+    """The simulator's configuration and faults from the parsed options; ``CliError`` if invalid."""
+    try:
+        config = SimConfig(rx_id=args.tx_id, tx_id=args.rx_id, legacy=args.legacy,
+                           push_rate_hz=args.push_rate, accel_dps2=args.accel, base_yaw_deg=args.base_yaw,
+                           yaw_continuous=args.yaw_continuous, version=args.version,
+                           calibration_s=args.calibration_time, camera_connected=not args.no_camera)
+        faults = Faults(drop=args.drop, corrupt=args.corrupt, direction=args.fault_direction,
+                        delay_s=args.delay_ms / 1000.0, nack=args.nack, nack_code=args.nack_code,
+                        silent=args.silent, legacy=args.legacy_fraction, foreign_rate=args.foreign_rate,
+                        seed=args.seed)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    if args.duration is not None and args.duration <= 0:
+        raise CliError(f"--duration must be positive, not {args.duration}")
+    if args.status_interval < 0:
+        raise CliError(f"--status-interval cannot be negative, not {args.status_interval}")
+    if args.tx_id == args.rx_id:
+        raise CliError(f"--tx-id and --rx-id must differ (both 0x{args.tx_id:03X})")
+    return config, faults
+
+
+def open_bus(args: argparse.Namespace) -> can.BusABC:
+    if args.interface == "sim":
+        raise CliError("'-i sim' is the in-process simulator; give 'sim' a real bus, e.g. -i udp_multicast")
+    kwargs: dict[str, Any] = {k: v for k, v in (("interface", args.interface), ("channel", args.channel),
+                                                 ("bitrate", args.bitrate)) if v is not None}
+    try:
+        return can.Bus(**kwargs)
+    except (can.CanError, OSError, ValueError, ImportError) as exc:
+        raise CliError(f"cannot open the CAN bus ({', '.join(f'{k}={v}' for k, v in kwargs.items())}): {exc}") from None
+
+
+def status_line(state: SimState, elapsed: float) -> str:
+    """One short human-readable line; ``elapsed`` = seconds since start."""
+    yaw, roll, pitch = state.joint
+    vy, vr, vp = state.speeds
+    faults = sum(state.faults.values())
+    return (f"t={elapsed:.1f} joint yaw={yaw:.1f} roll={roll:.1f} pitch={pitch:.1f} "
+            f"speed={vy:.1f}/{vr:.1f}/{vp:.1f} motors={'on' if state.motors_on else 'off'} "
+            f"rec={'on' if state.recording else 'off'} push={'on' if state.push_enabled else 'off'} "
+            f"commands={sum(state.commands.values())} faults={faults}")
+
+
+def run(args: argparse.Namespace) -> int:
+    config, faults = build(args)
+    bus = open_bus(args)
+    stop = threading.Event()
+
+    def on_signal(signum: int, frame: FrameType | None) -> None:
+        stop.set()
+
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with SimulatedGimbal(bus, config, faults) as sim:
+            start = time.monotonic()
+            deadline = None if args.duration is None else start + args.duration
+            next_status = start + args.status_interval if args.status_interval else None
+            while True:
+                due = [t for t in (deadline, next_status) if t is not None]
+                if stop.wait(max(0.0, min(due) - time.monotonic()) if due else None):
+                    break
+                now = time.monotonic()
+                if deadline is not None and now >= deadline:
+                    break
+                if next_status is not None and now >= next_status:
+                    state = sim.state()
+                    print(json.dumps(state.as_dict()) if args.json else status_line(state, now - start),
+                          flush=True)
+                    next_status += args.status_interval
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        bus.shutdown()
+    return 0
