@@ -1,0 +1,282 @@
+"""The session behind ``gimbaltrack track``: frames -> tracker -> control -> gimbal, with outputs.
+
+Every output is written as the run goes, so a run that fails or is interrupted keeps what it
+had; ``finish`` always stops the gimbal (zero speed, release) before anything else.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gimbal.client import GimbalClient
+from gimbal.errors import GimbalError
+from gimbal.messages import ParameterPush
+from pipelines.acquire import pick_candidate
+from pipelines.control import AttitudeHistory, CameraModel, ControlConfig, make_controller
+from pipelines.outputs.annotated_video import AnnotatedVideoWriter
+from pipelines.outputs.latency import latency_percentiles
+from pipelines.outputs.plot import write_timeseries_png
+from pipelines.outputs.summary import write_summary
+from pipelines.outputs.telemetry import TelemetryWriter, estimate_fields
+from pipelines.progress import ProgressReporter
+from pipelines.sources import Frame, FrameSource
+from tracker import make_tracker
+from tracker.detectors import Detector, make_detector
+from tracker.estimate import TargetEstimate, TrackState
+
+log = logging.getLogger(__name__)
+
+SUMMARY_EVERY_S = 1.0
+FEEDBACK_MODES = ("auto", "on", "off")
+
+
+@dataclass
+class TrackOptions:
+    """What the user chose; defaults are what ``gimbaltrack track SOURCE`` does."""
+
+    out_dir: Path
+    roi: tuple[int, int, int, int] | None = None
+    detect: str | None = None
+    pick: str = "central"
+    tracker: str = "default"
+    model_dir: Path | None = None
+    controller: str = "pid"
+    hfov_deg: float | None = None
+    rate_hz: float = 25.0
+    max_speed_dps: float = 180.0
+    record: bool = False
+    realtime: bool = False
+    attitude_feedback: str = "auto"
+    max_frames: int | None = None
+    video: bool = True
+    progress: bool = True
+    redetect_every: int = 10
+
+
+@dataclass
+class _Series:
+    """What the plot shows, one value per frame."""
+
+    t: list[float] = field(default_factory=list)
+    yaw_error: list[float] = field(default_factory=list)
+    pitch_error: list[float] = field(default_factory=list)
+    yaw_rate: list[float] = field(default_factory=list)
+    pitch_rate: list[float] = field(default_factory=list)
+
+
+class TrackSession:
+    """One tracking run against an open source and an open gimbal client."""
+
+    def __init__(self, options: TrackOptions, source: FrameSource, client: GimbalClient,
+                 bus_description: str) -> None:
+        self.options = options
+        self.source = source
+        self.client = client
+        self.bus_description = bus_description
+        width, height = source.size
+        self.camera = CameraModel(width, height, hfov_deg=options.hfov_deg)
+        self.controller = make_controller(options.controller, camera=self.camera,
+                                          config=ControlConfig(max_speed_dps=options.max_speed_dps))
+        self.tracker = make_tracker(options.tracker, options.model_dir)
+        self.detector: Detector | None = (make_detector(options.detect, options.model_dir)
+                                          if options.detect else None)
+        self.feedback = (source.is_live if options.attitude_feedback == "auto"
+                         else options.attitude_feedback == "on")
+        self.history = AttitudeHistory()
+        # live and realtime frames carry monotonic capture times; fast file playback stamps on read
+        self._monotonic_stamps = source.is_live or options.realtime
+        self.states: Counter[str] = Counter()
+        self.series = _Series()
+        self.frames = 0
+        self.first_acquired_s: float | None = None
+        self.recording: dict[str, Any] = {"requested": options.record}
+        self.reason = "running"
+        self.error: str | None = None
+        self._estimate: TargetEstimate | None = None
+        self._started = time.monotonic()
+        self._last_summary = 0.0
+        self._streamer = None
+        self._progress = ProgressReporter(source.frame_count if not source.is_live else None,
+                                          enabled=options.progress)
+        out = options.out_dir
+        self.paths = {"telemetry": out / "telemetry.jsonl", "can_log": out / "can.log",
+                      "summary": out / "summary.json", "plot": out / "plot.png"}
+        self.telemetry = TelemetryWriter(self.paths["telemetry"])
+        self.video: AnnotatedVideoWriter | None = None
+        if options.video:
+            self.paths["video"] = out / "annotated.avi"
+            self.video = AnnotatedVideoWriter(self.paths["video"], source.size, source.fps or 30.0)
+
+    # -- the run -------------------------------------------------------------------------
+    def start(self) -> None:
+        """Subscribe to the attitude push and start the speed keep-alive."""
+        self.client.on_push(ParameterPush, self.history.on_push)
+        self.client.set_push(True)
+        self._streamer = self.client.speed_streamer(rate_hz=self.options.rate_hz)
+
+    def run(self) -> None:
+        """Process frames until the source ends or ``max_frames``; exceptions propagate."""
+        for frame in self.source:
+            self.step(frame)
+            if self.options.max_frames is not None and self.frames >= self.options.max_frames:
+                self.reason = "max frames reached"
+                return
+        self.reason = "end of source"
+
+    def step(self, frame: Frame) -> None:
+        """One frame: track, control, stream the setpoint, write the outputs."""
+        stamp = frame.timestamp if self._monotonic_stamps else time.monotonic()
+        estimate = self._track(frame, stamp)
+        attitude = self._attitude_at(stamp)
+        command = self.controller.update(estimate, attitude, time.monotonic())
+        self._streamer.set(command.yaw_dps, command.pitch_dps, stamp=stamp)
+        if estimate is not None and estimate.found and self.first_acquired_s is None:
+            self.first_acquired_s = time.monotonic() - self._started
+            if self.options.record:
+                self._start_recording()
+        self.frames += 1
+        state = estimate.state.value if estimate is not None else "acquiring"
+        self.states[state] += 1
+        self._write_frame(frame, stamp, estimate, command)
+        self._progress.update(self.frames, f"{state:<9} yaw {command.yaw_dps:+6.1f} "
+                                           f"pitch {command.pitch_dps:+6.1f} deg/s")
+        if time.monotonic() - self._last_summary >= SUMMARY_EVERY_S:
+            self.write_summary()
+
+    def _track(self, frame: Frame, stamp: float) -> TargetEstimate | None:
+        if self._estimate is None:
+            box = self.options.roi if self.options.roi is not None else self._detect(frame, None)
+            if box is None:
+                return None
+            self._estimate = self.tracker.init(frame.image, box, stamp)
+            return self._estimate
+        estimate = self.tracker.update(frame.image, stamp)
+        if (estimate.state is TrackState.LOST and self.detector is not None
+                and self.frames % self.options.redetect_every == 0):
+            box = self._detect(frame, estimate.center)
+            if box is not None:
+                estimate = self.tracker.init(frame.image, box, stamp)
+        self._estimate = estimate
+        return estimate
+
+    def _detect(self, frame: Frame, near: tuple[float, float] | None) -> tuple[float, ...] | None:
+        if self.detector is None:
+            return None
+        found = pick_candidate(self.detector.detect(frame.image), self.source.size,
+                               self.options.pick, near)
+        return None if found is None else tuple(found.box)
+
+    def _attitude_at(self, stamp: float) -> tuple[float, float] | None:
+        """The gimbal's yaw/pitch at the frame's time when the camera rides on the gimbal; a fixed
+        (0, 0) for recorded footage, whose image does not move with the gimbal."""
+        if not self.feedback:
+            return (0.0, 0.0)
+        sample = self.history.at(stamp)
+        return None if sample is None else (sample.yaw, sample.pitch)
+
+    def _write_frame(self, frame: Frame, stamp: float, estimate: TargetEstimate | None,
+                     command: Any) -> None:
+        attitude = self.history.latest()
+        record: dict[str, Any] = {"frame": frame.index, "t": stamp,
+                                  "t_run": time.monotonic() - self._started,
+                                  "state": "acquiring" if estimate is None else estimate.state.value}
+        if estimate is not None:
+            record.update(estimate_fields(estimate))
+            record["frame"] = frame.index
+        record.update({"error_deg": [command.yaw_error_deg, command.pitch_error_deg],
+                       "rates_dps": [command.yaw_dps, command.pitch_dps], "mode": command.mode,
+                       "attitude_deg": None if attitude is None else
+                       [attitude.yaw, attitude.roll, attitude.pitch]})
+        self.telemetry.write(record)
+        if self.video is not None:
+            self.video.write(frame.image, estimate, (command.yaw_dps, command.pitch_dps),
+                             [f"mode {command.mode}"])
+        s = self.series
+        s.t.append(record["t_run"])
+        s.yaw_error.append(command.yaw_error_deg)
+        s.pitch_error.append(command.pitch_error_deg)
+        s.yaw_rate.append(command.yaw_dps)
+        s.pitch_rate.append(command.pitch_dps)
+
+    # -- recording -----------------------------------------------------------------------
+    def _start_recording(self) -> None:
+        try:
+            self.client.start_recording()
+            self.recording["started"] = True
+            self.recording["start_confirmed"] = self.client.camera_status() is True
+        except GimbalError as exc:
+            self.recording["started"] = False
+            self.recording["error"] = str(exc)
+
+    def _stop_recording(self) -> None:
+        if not self.recording.get("started"):
+            return
+        try:
+            self.client.stop_recording()
+            self.recording["stopped"] = True
+            self.recording["stop_confirmed"] = self.client.camera_status() is False
+        except GimbalError as exc:
+            self.recording["stopped"] = False
+            self.recording["error"] = str(exc)
+
+    # -- the end -------------------------------------------------------------------------
+    def finish(self, reason: str | None = None, error: str | None = None) -> dict[str, Any]:
+        """Stop the gimbal, stop recording, finalise every output; safe to call after any failure."""
+        if reason:
+            self.reason = reason
+        self.error = error or self.error
+        if self._streamer is not None:
+            try:
+                self._streamer.stop()
+            except (GimbalError, OSError) as exc:
+                log.warning("could not send the stop command: %s", exc)
+        try:
+            self._stop_recording()
+        except OSError as exc:  # a bus that went away
+            self.recording["error"] = str(exc)
+        self._progress.update(self.frames, self.reason, force=True)
+        self._progress.close()
+        self.telemetry.close()
+        if self.video is not None:
+            self.video.close()
+        summary = self.write_summary()
+        if self.series.t:
+            s = self.series
+            write_timeseries_png(
+                self.paths["plot"], s.t,
+                [{"yaw": s.yaw_error, "pitch": s.pitch_error}, {"yaw": s.yaw_rate, "pitch": s.pitch_rate}],
+                titles=["angular error (target - pointing)", "commanded rates"],
+                ylabels=["deg", "deg/s"])
+        return summary
+
+    def write_summary(self) -> dict[str, Any]:
+        """Write the summary as it stands (atomically) and return it."""
+        self._last_summary = time.monotonic()
+        elapsed = self._last_summary - self._started
+        streamer = self._streamer
+        latencies = streamer.latencies() if streamer is not None else []
+        errors = np.hypot(self.series.yaw_error, self.series.pitch_error) if self.series.t else np.zeros(0)
+        summary = {
+            "status": self.reason, "error": self.error,
+            "source": self.source.description, "live": self.source.is_live,
+            "bus": self.bus_description, "tracker": self.tracker.name, "controller": self.options.controller,
+            "attitude_feedback": self.feedback,
+            "frames": self.frames, "elapsed_s": elapsed, "fps": self.frames / elapsed if elapsed > 0 else None,
+            "frames_dropped": self.source.dropped,
+            "states": dict(self.states), "first_acquired_s": self.first_acquired_s,
+            "angular_error_deg": {"mean": float(errors.mean()) if errors.size else None,
+                                  "max": float(errors.max()) if errors.size else None},
+            "latency_ms": {k: (v * 1000.0 if isinstance(v, float) else v)
+                           for k, v in latency_percentiles(latencies).items()},
+            "speed_commands": dict(streamer.stats) if streamer is not None else {},
+            "recording": self.recording,
+            "outputs": {k: str(v) for k, v in self.paths.items()},
+        }
+        write_summary(self.paths["summary"], summary)
+        return summary
