@@ -326,8 +326,9 @@ class GimbalModel:
         self.focus.dial(msg.dial_speed / DIAL_FULL_SCALE, now, self.config.speed_timeout_s)
 
     def _focus_calibration(self, msg: external.FocusCalibration, now: float) -> Reply:
+        """A calibration step that cannot be done is reported in ``result`` (1), not the return code."""
         done = self.focus.calibrate(msg.calibration_cmd, now)
-        return msg.REPLY(OK if done else FAILED, msg.sub_id, msg.motor_type, 0 if done else 1)
+        return msg.REPLY(OK, msg.sub_id, msg.motor_type, 0 if done else 1)
 
     def _focus_query(self, msg: external.FocusPositionQuery, now: float) -> Reply:
         return msg.REPLY(OK, msg.sub_id, msg.motor_type, self.focus.state, round(self.focus.position))

@@ -30,3 +30,21 @@ def make_sim() -> Iterator:  # type: ignore[type-arg]
 def sim_host(make_sim):  # type: ignore[no-untyped-def]
     host, sim, _ = make_sim()
     return host, sim
+
+
+@pytest.fixture
+def make_client(make_sim):  # type: ignore[no-untyped-def]
+    """Factory: ``make_client(config=None, faults=None, **client_kwargs) -> (GimbalClient, sim)``;
+    clients are closed (safety stop) before their simulators stop."""
+    from gimbal.client import GimbalClient
+    clients: list[GimbalClient] = []
+
+    def make(config: SimConfig | None = None, faults: Faults | None = None, **kwargs):  # type: ignore[no-untyped-def]
+        _, sim, bus = make_sim(config, faults)
+        client = GimbalClient(bus, **kwargs)
+        clients.append(client)
+        return client, sim
+
+    yield make
+    for client in clients:
+        client.close()
