@@ -5,7 +5,8 @@ rounding to the nearest unit and range-checked by the messages (``RangeError``) 
 is sent.
 
 Replies are matched to requests by SEQ when the gimbal echoes it, otherwise by CmdSet/CmdID
-(latest layout) or to the oldest outstanding request (legacy layout, which has no CmdSet/CmdID).
+(latest layout) or to the oldest outstanding request (legacy layout, which has no CmdSet/CmdID);
+once the gimbal has echoed a SEQ, a reply with an unknown SEQ is stale.
 A retry resends the *same* packet with the same SEQ, so a late reply to any attempt completes the
 call. Commands whose repetition changes the outcome (relative moves, toggles, camera actions)
 are never retried. Replies that match no outstanding request are counted in ``stats`` and dropped.
@@ -190,6 +191,7 @@ class GimbalClient:
         self._lock = threading.Lock()
         self._pending: dict[int, PendingReply] = {}
         self._seq = FIRST_SEQ
+        self._seq_echoed = False  # learnt from the first reply that echoes its request's SEQ
         self._closing = threading.Event()
         self._closed = False
         self._rx_error: BaseException | None = None
@@ -309,16 +311,22 @@ class GimbalClient:
             self.stats["ignored"] += 1
 
     def _match(self, packet: Packet) -> PendingReply | None:
-        """Pop the waiter a reply belongs to (see the module docstring)."""
+        """Pop the waiter a reply belongs to.
+
+        By SEQ first. Until the gimbal has been seen echoing SEQs, a reply whose SEQ matches
+        nothing goes to the oldest request with its CmdSet/CmdID (latest layout) or to the oldest
+        request (legacy layout); once echoing is seen, such a reply is stale.
+        """
+        legacy = is_legacy_reply(packet)
+        key = None if legacy else (packet.data[0], packet.data[1])
         with self._lock:
             waiter = self._pending.get(packet.seq)
-            if is_legacy_reply(packet):
-                if waiter is None:
-                    waiter = next(iter(self._pending.values()), None)
+            if waiter is not None and (legacy or waiter.key == key):
+                self._seq_echoed = True
+            elif self._seq_echoed:
+                waiter = None
             else:
-                key = (packet.data[0], packet.data[1])
-                if waiter is None or waiter.key != key:
-                    waiter = next((w for w in self._pending.values() if w.key == key), None)
+                waiter = next((w for w in self._pending.values() if legacy or w.key == key), None)
             if waiter is not None:
                 del self._pending[waiter.seq]
             return waiter

@@ -114,10 +114,13 @@ class SpeedStreamer:
         self._client.stop_and_release()
 
     def halt(self, error: BaseException) -> None:
-        """Stop streaming because the bus is lost (called by the client; does not block)."""
+        """Stop streaming because the bus is lost (called by the client before its best-effort
+        stop): returns once the thread has finished its current send, so nothing follows the stop."""
         self.error = self.error or error
         self._halt.set()
         self._wake.set()
+        if self._thread is not threading.current_thread():
+            self._thread.join(timeout=2.0)
 
     def _run(self) -> None:
         period = 1.0 / self.rate_hz

@@ -9,9 +9,11 @@ from dataclasses import dataclass
 from types import TracebackType
 
 import can
+from can.interfaces.virtual import VirtualBus
 
 from gimbal.framer import Dropped
 from gimbal.messages import Message, decode_message, message_packet
+from gimbal.messages.motion import SpeedControl
 from gimbal.packet import Packet
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport
 
@@ -145,3 +147,38 @@ class ScriptedPeer:
         except can.CanError:
             pass
 
+
+def poll(condition: Callable[[], bool], timeout: float = 5.0) -> None:
+    """Wait for something the other threads do; fail after a generous timeout."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "condition not reached"
+        time.sleep(0.005)
+
+
+class FlakyBus(VirtualBus):
+    """A virtual bus whose receive (or send) side can be made to fail, as when an adapter is
+    unplugged."""
+
+    fail_recv = False
+    fail_send = False
+
+    def _recv_internal(self, timeout: float | None) -> tuple[can.Message | None, bool]:
+        if self.fail_recv:
+            raise can.CanOperationError("adapter gone")
+        return super()._recv_internal(timeout)
+
+    def send(self, msg: can.Message, timeout: float | None = None) -> None:
+        if self.fail_send:
+            raise can.CanOperationError("adapter gone")
+        super().send(msg, timeout)
+
+
+def speed_messages(peer: ScriptedPeer) -> list[tuple[int, int, int, int]]:
+    """(yaw, roll, pitch, ctrl_byte) of every speed command the peer received."""
+    return [(m.yaw_speed, m.roll_speed, m.pitch_speed, m.ctrl_byte)
+            for m in peer.messages(SpeedControl)]
+
+
+ZERO = (0, 0, 0, 0x88)  # zero speed, still in control
+RELEASE = (0, 0, 0, 0x08)  # zero speed, control released (bit 7 clear)

@@ -1,0 +1,363 @@
+"""GimbalClient against a scripted peer on python-can's virtual bus."""
+from __future__ import annotations
+
+import logging
+import signal
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import can
+import pytest
+from scripted_peer import RELEASE, ZERO, FlakyBus, ScriptedPeer, poll, speed_messages
+
+from gimbal.client import Angles, GimbalClient, exit_on_signals
+from gimbal.errors import BusError, GimbalTimeoutError, RangeError, ReturnCodeError
+from gimbal.messages import Message
+from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
+from gimbal.messages.external import (DialPush, FocusCalibration, FocusCalibrationReply,
+                                      FocusPositionControl, FocusPositionQuery, FocusPositionReply,
+                                      JoystickPush)
+from gimbal.messages.motion import AnglesReply, GetAngles, PositionControl, SpeedControl
+from gimbal.messages.settings import (ActiveTrack, AngleLimitsReply, GetAngleLimits,
+                                      GetMotorStiffness, MotorStiffnessReply, RecenterSelfie,
+                                      SetAngleLimits, SetFollowMode, SetMotorStiffness, SetWorkMode)
+from gimbal.messages.telemetry import (ParameterPush, PushControl, VersionPush, VersionQuery,
+                                       VersionReply)
+from gimbal.messages.tlv_params import (AutoCalibration, CalibrationStatusPush, GetUserParams,
+                                        SetUserParams, SetUserParamsReply, Tlv, UserParamsReply,
+                                        motors_off)
+from gimbal.packet import encode_packet
+
+DOC_EXAMPLE = bytes.fromhex("AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE")
+
+
+@pytest.fixture
+def channel() -> str:
+    return f"gimbal-test-{uuid.uuid4().hex}"
+
+
+@pytest.fixture
+def peer(channel: str) -> Iterator[ScriptedPeer]:
+    bus = can.Bus(interface="virtual", channel=channel)
+    with ScriptedPeer(bus) as scripted:
+        yield scripted
+    bus.shutdown()
+
+
+@pytest.fixture
+def client(channel: str, peer: ScriptedPeer) -> Iterator[GimbalClient]:
+    with GimbalClient(interface="virtual", channel=channel, timeout=0.2, retries=1) as gimbal:
+        yield gimbal
+
+
+def test_first_request_is_the_documents_example(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.answer(PositionControl)
+    client.position(yaw=3.2, roll=4.8, pitch=6.4, absolute=True, time_s=2)
+    assert encode_packet(peer.received[0].packet) == DOC_EXAMPLE
+
+
+# (call, command class, reply to give, expected DATA bytes, expected CmdType, check on the result)
+REQUESTS: list[tuple[Callable[[GimbalClient], Any], type[Message], Message | None, str, int,
+                     Callable[[Any], bool]]] = [
+    (lambda c: c.position(yaw=-1.26, axes=("yaw",), absolute=False, time_s=0.5), PositionControl,
+     None, "0E 00 F3FF 0000 0000 0C 05", 0x03, lambda r: r is None),
+    (lambda c: c.speed(10, -5, 1), SpeedControl, None, "0E 01 6400 0A00 CEFF 88", 0x03,
+     lambda r: r is None),
+    (lambda c: c.speed(0, 0, take_control=False), SpeedControl, None, "0E 01 0000 0000 0000 08",
+     0x03, lambda r: r is None),
+    (lambda c: c.get_angles("joint"), GetAngles, AnglesReply(0, 2, -900, 15, 1234), "0E 02 02",
+     0x03, lambda r: r == Angles("joint", -90.0, 1.5, 123.4)),
+    (lambda c: c.set_angle_limits(145, 55, 179, 179, 30, 30), SetAngleLimits, None,
+     "0E 03 01 91 37 B3 B3 1E 1E", 0x03, lambda r: r is None),
+    (lambda c: c.get_angle_limits(), GetAngleLimits, AngleLimitsReply(0, 100, 40, 90, 80, 20, 10),
+     "0E 04 01", 0x03, lambda r: (r.pitch_max, r.roll_min) == (100, 10)),
+    (lambda c: c.set_stiffness(10, 20, 30), SetMotorStiffness, None, "0E 05 01 0A 14 1E", 0x03,
+     lambda r: r is None),
+    (lambda c: c.get_stiffness(), GetMotorStiffness, MotorStiffnessReply(0, 10, 30, 20), "0E 06 01",
+     0x03, lambda r: (r.pitch_stiffness, r.yaw_stiffness, r.roll_stiffness) == (10, 30, 20)),
+    (lambda c: c.set_push(True), PushControl, None, "0E 07 01", 0x03, lambda r: r is None),
+    (lambda c: c.set_push(False), PushControl, None, "0E 07 02", 0x03, lambda r: r is None),
+    (lambda c: c.version(), VersionQuery, VersionReply(0, 1, 0x01020304), "0E 09 01000000", 0x03,
+     lambda r: r.version_text == "01.02.03.04"),
+    (lambda c: c.get_user_params([0x23]), GetUserParams, UserParamsReply(0, (Tlv(0x23, b"\x01"),)),
+     "0E 0B 23", 0x03, lambda r: r == (Tlv(0x23, b"\x01"),)),
+    (lambda c: c.set_user_params([motors_off(True)]), SetUserParams,
+     SetUserParamsReply(0, (Tlv(0x23, b"\x01"),)), "0E 0C 23 01 01", 0x03,
+     lambda r: r == (Tlv(0x23, b"\x01"),)),
+    (lambda c: c.set_work_mode("portrait"), SetWorkMode, None, "0E 0D FE 03", 0x03,
+     lambda r: r is None),
+    (lambda c: c.recenter(), RecenterSelfie, None, "0E 0E FE 01", 0x03, lambda r: r is None),
+    (lambda c: c.selfie(), RecenterSelfie, None, "0E 0E FE 02", 0x03, lambda r: r is None),
+    (lambda c: c.set_follow_mode("fpv"), SetFollowMode, None, "0E 0E 03 00", 0x03,
+     lambda r: r is None),
+    (lambda c: c.auto_calibration(True, 1), AutoCalibration, None, "0E 0F 00 01 03", 0x01,
+     lambda r: r is None),
+    (lambda c: c.activetrack_toggle(), ActiveTrack, None, "0E 11 03", 0x01, lambda r: r is None),
+    (lambda c: c.focus_calibration("auto"), FocusCalibration, FocusCalibrationReply(0, 2, 0, 1),
+     "0E 12 02 00 01", 0x03, lambda r: r is False),
+    (lambda c: c.focus_read(), FocusPositionQuery, FocusPositionReply(0, 0x15, 0, 3, 1234),
+     "0E 12 15 00", 0x03, lambda r: (r.calibration_state, r.position) == (3, 1234)),
+    (lambda c: c.photo(), CameraAction, None, "0D 00 0100", 0x03, lambda r: r is None),
+    (lambda c: c.start_recording(), CameraAction, None, "0D 00 0300", 0x03, lambda r: r is None),
+    (lambda c: c.stop_recording(), CameraAction, None, "0D 00 0400", 0x03, lambda r: r is None),
+    (lambda c: c.camera_action(5), CameraAction, None, "0D 00 0500", 0x03, lambda r: r is None),
+    (lambda c: c.camera_status(), CameraStatusQuery, CameraStatusReply(0, 2), "0D 01 01", 0x03,
+     lambda r: r is True),
+]
+
+
+@pytest.mark.parametrize("call,cls,reply,data,cmd_type,check", REQUESTS,
+                         ids=[f"{r[1].__name__}-{i}" for i, r in enumerate(REQUESTS)])
+def test_typed_requests_send_the_documents_bytes_and_parse_replies(
+        client: GimbalClient, peer: ScriptedPeer, call: Callable[[GimbalClient], Any],
+        cls: type[Message], reply: Message | None, data: str, cmd_type: int,
+        check: Callable[[Any], bool]) -> None:
+    peer.answer(cls, reply)
+    result = call(client)
+    sent = peer.received[-1].packet
+    assert sent.data == bytes.fromhex(data)
+    assert sent.cmd_type == cmd_type
+    assert check(result), result
+
+
+PUSHES: list[tuple[Callable[[GimbalClient], None], type[Message], str]] = [
+    (lambda c: c.push_version(2, 0x01000000), VersionPush, "0E 09 02000000 00000001"),
+    (lambda c: c.joystick(yaw=100, pitch=-200), JoystickPush, "0E 0A 01 38FF 0000 6400"),
+    (lambda c: c.dial(-2048), DialPush, "0E 0A 02 00F8"),
+    (lambda c: c.focus_position(4095), FocusPositionControl, "0E 12 01 00 02 FF0F"),
+]
+
+
+@pytest.mark.parametrize("call,cls,data", PUSHES, ids=[p[1].__name__ for p in PUSHES])
+def test_host_pushes_go_out_with_cmd_type_zero_and_wait_for_nothing(
+        client: GimbalClient, peer: ScriptedPeer, call: Callable[[GimbalClient], None],
+        cls: type[Message], data: str) -> None:
+    call(client)  # the peer never answers: this returns without waiting
+    peer.wait_for(cls)
+    sent = peer.received[-1].packet
+    assert (sent.data, sent.cmd_type) == (bytes.fromhex(data), 0x00)
+
+
+def test_out_of_range_values_raise_before_anything_is_sent(client: GimbalClient,
+                                                          peer: ScriptedPeer) -> None:
+    for call in (lambda: client.position(yaw=180.1), lambda: client.position(pitch=-56.1),
+                 lambda: client.speed(360.1, 0), lambda: client.speed(float("nan"), 0),
+                 lambda: client.set_stiffness(101, 0, 0), lambda: client.focus_position(4096),
+                 lambda: client.set_follow_mode("sideways"), lambda: client.get_angles("euler"),
+                 lambda: client.position(time_s=25.6), lambda: client.joystick(15001, 0)):
+        with pytest.raises(RangeError):
+            call()
+    assert peer.received == []
+
+
+def test_silence_raises_a_timeout_error_after_the_retries_with_the_same_seq(
+        client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.silence(GetAngles)
+    with pytest.raises(GimbalTimeoutError) as raised:
+        client.get_angles()
+    assert isinstance(raised.value, TimeoutError)
+    sent = [r.packet for r in peer.received]
+    assert len(sent) == 2 and sent[0] == sent[1]  # retries=1: two identical packets
+
+
+def test_a_retry_recovers_a_lost_reply(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.answer(GetAngles, AnglesReply(0, 1, 10, 20, 30), ignore_first=1)
+    assert client.get_angles() == Angles("attitude", 1.0, 2.0, 3.0)
+    assert client.stats["retries"] == 1
+
+
+@pytest.mark.parametrize("call,cls", [
+    (lambda c: c.position(yaw=5, absolute=False), PositionControl),
+    (lambda c: c.photo(), CameraAction),
+    (lambda c: c.selfie(), RecenterSelfie),
+], ids=["relative-move", "photo", "selfie"])
+def test_commands_that_must_not_repeat_are_never_retried(
+        client: GimbalClient, peer: ScriptedPeer, call: Callable[[GimbalClient], None],
+        cls: type[Message]) -> None:
+    peer.silence(cls)
+    with pytest.raises(GimbalTimeoutError):
+        call(client)
+    assert len(peer.received) == 1
+
+
+def test_reply_optional_commands_accept_silence(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.silence(ActiveTrack)
+    client.activetrack_toggle()
+    assert len(peer.received) == 1
+
+
+@pytest.mark.parametrize("code,meaning", [(0x01, "could not be parsed"),
+                                          (0x02, "could not be executed"),
+                                          (0xFF, "undefined error"),
+                                          (0x7F, "not defined by the document")])
+@pytest.mark.parametrize("legacy", [False, True], ids=["latest", "legacy"])
+def test_nack_return_codes_are_raised_with_their_meaning(
+        client: GimbalClient, peer: ScriptedPeer, code: int, meaning: str, legacy: bool) -> None:
+    peer.nack(GetAngleLimits, code, legacy=legacy)
+    with pytest.raises(ReturnCodeError, match=meaning) as raised:
+        client.get_angle_limits()
+    assert raised.value.return_code == code
+    assert len(peer.received) == 1  # a NACK is an answer: no retry
+
+
+def test_legacy_layout_replies_are_parsed(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.answer(GetAngles, AnglesReply(0, 1, -100, 0, 250), legacy=True)
+    assert client.get_angles() == Angles("attitude", -10.0, 0.0, 25.0)
+
+
+def test_replies_without_the_requests_seq_match_by_command(client: GimbalClient,
+                                                           peer: ScriptedPeer) -> None:
+    peer.answer(GetAngles, AnglesReply(0, 1, 1, 2, 3), seq=0x0001)  # firmware that ignores SEQ
+    assert client.get_angles().yaw == pytest.approx(0.1)
+    peer.answer(CameraStatusQuery, CameraStatusReply(0, 0), seq=0x0001, legacy=True)
+    assert client.camera_status() is False
+
+
+def test_late_replies_are_dropped_as_stale(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.answer(VersionQuery, VersionReply(0, 1, 0x01000000))
+    client.version()  # the gimbal echoes SEQs: later unknown SEQs are stale
+    peer.answer(GetAngles, AnglesReply(0, 1, 111, 0, 0), delay=0.5)
+    with pytest.raises(GimbalTimeoutError):
+        client.request(GetAngles(), timeout=0.05, retries=0)
+    peer.answer(GetAngles, AnglesReply(0, 1, 222, 0, 0))
+    assert client.get_angles().yaw == pytest.approx(22.2)
+    poll(lambda: client.stats["stale_replies"] == 1)
+    assert client.get_angles().yaw == pytest.approx(22.2)
+
+
+def test_concurrent_requests_get_their_own_replies(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.answer(GetAngles, lambda m: AnglesReply(0, m.ctrl_byte, m.ctrl_byte * 100, 0, 0))
+    results: dict[str, Angles] = {}
+
+    def ask(kind: str) -> None:
+        for _ in range(20):
+            results[kind] = client.get_angles(kind)
+            assert results[kind].kind == kind
+            assert results[kind].yaw == (10.0 if kind == "attitude" else 20.0)
+
+    threads = [threading.Thread(target=ask, args=(k,)) for k in ("attitude", "joint")]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert set(results) == {"attitude", "joint"}
+
+
+def test_pushes_reach_callbacks_with_arrival_times(client: GimbalClient, peer: ScriptedPeer) -> None:
+    got: list[tuple[Message, float]] = []
+    client.on_push(ParameterPush, lambda m, t: got.append((m, t)))
+    assert client.latest(ParameterPush) is None
+    before = time.monotonic()
+    push = ParameterPush(0x01, 10, 20, 30, 40, 50, 60)  # a short push: limits and stiffness absent
+    peer.push(push, cmd_type=0x20)  # some firmware sets the reply bit on pushes
+    poll(lambda: len(got) == 1)
+    message, t = got[0]
+    assert message.yaw_angle == 10 and message.pitch_stiffness is None and message.angles_valid
+    assert before <= t <= time.monotonic()
+    assert client.latest(ParameterPush) == (message, t)
+
+
+def test_wait_for_push_returns_the_next_one(client: GimbalClient, peer: ScriptedPeer) -> None:
+    status = CalibrationStatusPush.of(1, 42)
+    threading.Timer(0.05, peer.push, (status,)).start()
+    message, _ = client.wait_for_push(CalibrationStatusPush, timeout=5.0)
+    assert (message.state, message.progress) == (1, 42)
+    with pytest.raises(GimbalTimeoutError):
+        client.wait_for_push(CalibrationStatusPush, timeout=0.05)
+    with pytest.raises(ValueError):
+        client.on_push(GetAngles, lambda m, t: None)
+
+
+def test_a_failing_callback_is_logged_and_does_not_stop_delivery(
+        client: GimbalClient, peer: ScriptedPeer, caplog: pytest.LogCaptureFixture) -> None:
+    def broken(message: Message, t: float) -> None:
+        raise RuntimeError("user bug")
+
+    got: list[Message] = []
+    client.on_push(ParameterPush, broken)
+    client.on_push(ParameterPush, lambda m, t: got.append(m))
+    with caplog.at_level(logging.ERROR, logger="gimbal.pushes"):
+        peer.push(ParameterPush(0x01, 1, 2, 3, 4, 5, 6))
+        peer.push(ParameterPush(0x01, 7, 8, 9, 10, 11, 12))
+        poll(lambda: len(got) == 2)
+    assert "user bug" in caplog.text
+    peer.answer(GetAngleLimits, AngleLimitsReply(0, 1, 2, 3, 4, 5, 6))
+    assert client.get_angle_limits().pitch_max == 1  # the receive thread is alive
+
+
+def test_a_dead_receive_thread_is_raised_on_the_next_call_and_stops_the_gimbal(
+        channel: str, peer: ScriptedPeer) -> None:
+    bus = FlakyBus(channel=channel)
+    peer.answer(SpeedControl)
+    with GimbalClient(bus, timeout=0.2) as gimbal:
+        gimbal.speed(20, 0)
+        bus.fail_recv = True
+        poll(lambda: not gimbal.alive)
+        with pytest.raises(BusError, match="adapter gone"):
+            gimbal.get_angles()
+        poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])
+    bus.shutdown()
+
+
+def test_leaving_the_client_stops_and_releases_speed_control(client: GimbalClient,
+                                                             peer: ScriptedPeer) -> None:
+    peer.answer(SpeedControl)
+    client.speed(30, -10)
+    client.close()
+    assert speed_messages(peer) == [(300, 0, -100, 0x88), ZERO, RELEASE]
+    client.close()  # idempotent
+    assert len(speed_messages(peer)) == 3
+
+
+def test_an_exception_inside_the_context_still_sends_the_safety_stop(
+        channel: str, peer: ScriptedPeer) -> None:
+    peer.answer(SpeedControl)
+    with pytest.raises(KeyboardInterrupt):
+        with GimbalClient(interface="virtual", channel=channel) as gimbal:
+            gimbal.speed(0, 15)
+            raise KeyboardInterrupt
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+
+
+def test_sigterm_becomes_a_clean_exit_with_the_safety_stop(channel: str, peer: ScriptedPeer) -> None:
+    peer.answer(SpeedControl)
+    previous = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(SystemExit) as raised:
+        with exit_on_signals(), GimbalClient(interface="virtual", channel=channel) as gimbal:
+            gimbal.speed(0, 15)
+            signal.raise_signal(signal.SIGTERM)
+    assert raised.value.code == 128 + signal.SIGTERM
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+    assert signal.getsignal(signal.SIGTERM) is previous
+
+
+def test_no_speed_command_on_exit_when_speed_was_never_used(client: GimbalClient,
+                                                            peer: ScriptedPeer) -> None:
+    peer.answer(PushControl)
+    client.set_push(True)
+    client.close()
+    assert speed_messages(peer) == []
+
+
+def test_only_buses_the_client_built_are_shut_down(channel: str, peer: ScriptedPeer) -> None:
+    with GimbalClient(interface="virtual", channel=channel) as built:
+        pass
+    with pytest.raises(can.CanOperationError):
+        built.bus.send(can.Message(arbitration_id=1))
+    given = can.Bus(interface="virtual", channel=channel)
+    with GimbalClient(given):
+        pass
+    given.send(can.Message(arbitration_id=1))  # still open
+    given.shutdown()
+
+
+def test_an_unconfigured_bus_is_a_bus_error(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
+    monkeypatch.setattr(can, "rc", {})
+    monkeypatch.setenv("HOME", str(tmp_path))
+    for name in ("CAN_INTERFACE", "CAN_CHANNEL", "CAN_BITRATE", "CAN_CONFIG"):
+        monkeypatch.delenv(name, raising=False)
+    with pytest.raises(BusError, match="cannot open the CAN bus"):
+        GimbalClient()

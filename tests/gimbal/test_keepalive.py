@@ -1,0 +1,170 @@
+"""SpeedStreamer: rate, the max_age rule, stop, latencies and bus loss, against a scripted peer."""
+from __future__ import annotations
+
+import time
+import uuid
+from collections.abc import Iterator
+
+import can
+import pytest
+from scripted_peer import RELEASE, ZERO, FlakyBus, ScriptedPeer, poll, speed_messages
+
+from gimbal.client import GimbalClient
+from gimbal.errors import BusError, GimbalError, RangeError
+from gimbal.keepalive import SpeedStreamer
+from gimbal.messages.motion import SpeedControl
+
+
+class FakeClock:
+    def __init__(self, now: float = 100.0) -> None:
+        self.now = now
+
+    def __call__(self) -> float:
+        return self.now
+
+
+@pytest.fixture
+def channel() -> str:
+    return f"keepalive-test-{uuid.uuid4().hex}"
+
+
+@pytest.fixture
+def peer(channel: str) -> Iterator[ScriptedPeer]:
+    bus = can.Bus(interface="virtual", channel=channel)
+    with ScriptedPeer(bus) as scripted:
+        scripted.answer(SpeedControl)
+        yield scripted
+    bus.shutdown()
+
+
+@pytest.fixture
+def client(channel: str, peer: ScriptedPeer) -> Iterator[GimbalClient]:
+    with GimbalClient(interface="virtual", channel=channel) as gimbal:
+        yield gimbal
+
+
+def test_the_setpoint_is_resent_at_the_configured_rate(client: GimbalClient, peer: ScriptedPeer) -> None:
+    streamer = client.speed_streamer(rate_hz=25.0, max_age=60.0)
+    streamer.set(12.3, -4.5, 0.6)
+    peer.wait_for(SpeedControl, 30, where=lambda m: m.yaw_speed == 123)
+    times = [r.t for r in peer.received if isinstance(r.message, SpeedControl)
+             and r.message.yaw_speed == 123]
+    rate = (len(times) - 1) / (times[-1] - times[0])
+    assert 12 < rate < 40  # 25 Hz with generous bounds for a loaded machine
+    message = peer.messages(SpeedControl)[-1]
+    assert (message.yaw_speed, message.roll_speed, message.pitch_speed, message.ctrl_byte) \
+        == (123, 6, -45, 0x88)
+    assert streamer.stats["reply_timeouts"] == 0
+
+
+def test_a_stale_setpoint_is_never_resent(client: GimbalClient, peer: ScriptedPeer) -> None:
+    clock = FakeClock()
+    streamer = SpeedStreamer(client, rate_hz=50.0, max_age=0.3, clock=clock)
+    try:
+        streamer.set(10, 0)
+        peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 100)
+        clock.now += 0.31
+        seen = len(peer.messages(SpeedControl))
+        peer.wait_for(SpeedControl, seen + 5)
+        after = speed_messages(peer)[seen + 1:]  # one send may have read the clock before the jump
+        assert after and all(m == ZERO for m in after)
+        assert streamer.stats["zero_sent"] >= len(after)
+    finally:
+        streamer.stop()
+
+
+def test_setpoints_are_clamped_and_nan_refused(client: GimbalClient, peer: ScriptedPeer) -> None:
+    streamer = client.speed_streamer()
+    streamer.set(1000, -1000, 400)
+    peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 3600)
+    assert speed_messages(peer)[-1] == (3600, 3600, -3600, 0x88)
+    with pytest.raises(RangeError):
+        streamer.set(float("nan"), 0)
+
+
+def test_stop_sends_zero_then_releases_control(client: GimbalClient, peer: ScriptedPeer) -> None:
+    streamer = client.speed_streamer()
+    streamer.set(5, 5)
+    peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 50)
+    streamer.stop()
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+    count = len(peer.messages(SpeedControl))
+    with pytest.raises(GimbalError):
+        streamer.set(1, 1)
+    streamer.stop()
+    client.close()  # control already released: nothing more to send
+    assert len(peer.messages(SpeedControl)) == count
+
+
+def test_leaving_the_client_stops_a_running_streamer(channel: str, peer: ScriptedPeer) -> None:
+    with pytest.raises(RuntimeError):
+        with GimbalClient(interface="virtual", channel=channel) as gimbal:
+            streamer = gimbal.speed_streamer()
+            streamer.set(0, 20)
+            peer.wait_for(SpeedControl, where=lambda m: m.pitch_speed == 200)
+            raise RuntimeError("tracker crashed")
+    assert not streamer.running
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+
+
+def test_latency_is_stamp_to_first_send(client: GimbalClient, peer: ScriptedPeer) -> None:
+    clock = FakeClock(50.0)
+    streamer = SpeedStreamer(client, clock=clock)
+    try:
+        streamer.set(1, 1, stamp=49.9)
+        poll(lambda: len(streamer.latencies()) == 1)
+        peer.wait_for(SpeedControl, 5)
+        assert streamer.latencies() == [pytest.approx(0.1)]  # counted once, not per resend
+    finally:
+        streamer.stop()
+
+
+def test_reply_errors_are_counted_and_streaming_goes_on(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.nack(SpeedControl, 0x02)
+    streamer = client.speed_streamer()
+    poll(lambda: streamer.stats["reply_errors"] >= 3)
+    assert streamer.running and streamer.error is None
+    streamer.set(1, 0)
+
+
+def test_consecutive_reply_timeouts_mean_the_gimbal_is_lost(client: GimbalClient, peer: ScriptedPeer) -> None:
+    peer.silence(SpeedControl)
+    streamer = SpeedStreamer(client, max_missed_replies=3)
+    poll(lambda: streamer.error is not None)
+    assert not streamer.running
+    assert streamer.stats["reply_timeouts"] == 3
+    with pytest.raises(BusError, match="3 consecutive"):
+        streamer.set(1, 0)
+    poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])  # the best-effort stop went out
+
+
+def test_a_refused_send_stops_streaming(channel: str, peer: ScriptedPeer) -> None:
+    bus = FlakyBus(channel=channel)
+    with GimbalClient(bus) as gimbal:
+        streamer = gimbal.speed_streamer()
+        streamer.set(3, 3)
+        peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 30)
+        bus.fail_send = True
+        poll(lambda: streamer.error is not None)
+        with pytest.raises(BusError, match="adapter gone"):
+            streamer.set(1, 0)
+        bus.fail_send = False  # the adapter comes back: leaving still stops the gimbal
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+    bus.shutdown()
+
+
+def test_a_lost_receive_side_halts_the_streamer_and_stops_the_gimbal(channel: str,
+                                                                      peer: ScriptedPeer) -> None:
+    bus = FlakyBus(channel=channel)
+    with GimbalClient(bus) as gimbal:
+        streamer = gimbal.speed_streamer()
+        streamer.set(3, 3)
+        peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 30)
+        bus.fail_recv = True
+        poll(lambda: streamer.error is not None)
+        with pytest.raises(BusError):
+            streamer.set(1, 0)
+        poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])
+        time.sleep(0.1)  # nothing moves the gimbal after the stop
+        assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+    bus.shutdown()
