@@ -1,5 +1,8 @@
 """CAN traffic (both directions) -> one JSON-ready record per DJI R SDK packet or drop.
 
+Records carry document field names with raw wire values; a value the document does not allow
+(e.g. a speed ctrl_byte of 0x44) is decoded as sent and flagged in ``out_of_range``.
+
 ``LogDecoder`` is the incremental API (``feed_frame`` / ``feed_bytes`` / ``finish``);
 ``decode_frames`` and ``decode_log_file`` wrap it for whole captures. Nothing here raises on bad
 input: whatever cannot be decoded becomes a record with an ``error`` key and the raw ``hex``.
@@ -15,7 +18,7 @@ from typing import Any
 
 import can
 
-from gimbal.errors import PayloadError, UnknownMessageError, describe_return_code
+from gimbal.errors import PayloadError, RangeError, UnknownMessageError, describe_return_code
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.messages import Kind, Message, decode_message, is_legacy_reply
 from gimbal.messages.base import DEVICE_PUSHES
@@ -120,6 +123,10 @@ class LogDecoder:
             record["layout"] = "legacy" if legacy else "latest"
             if match is not None:
                 record["request_seq"] = match.seq
+        try:
+            message.validate()
+        except RangeError as exc:  # decoded as sent, but outside what the document allows
+            record["out_of_range"] = str(exc)
         code = getattr(message, "return_code", None)
         if code is not None:
             record["return_code_meaning"] = describe_return_code(code)

@@ -1,0 +1,164 @@
+"""CanTransport over python-can's virtual bus: whole packets, no interleaving, foreign ids ignored."""
+from __future__ import annotations
+
+import itertools
+import threading
+import time
+from collections.abc import Iterator
+
+import can
+import pytest
+
+from gimbal.framer import Dropped
+from gimbal.messages import message_packet
+from gimbal.messages.motion import AnglesReply, SpeedControl
+from gimbal.messages.telemetry import ParameterPush
+from gimbal.packet import Packet, decode_packet, encode_packet
+from gimbal.transport import CanTransport, packet_frames
+
+_channels = itertools.count()
+
+
+class YieldingBus(can.BusABC):
+    """A virtual bus that gives up the GIL after every frame, so unguarded senders interleave."""
+
+    def __init__(self, channel: str) -> None:
+        self._inner = can.Bus(interface="virtual", channel=channel)
+        super().__init__(channel=channel)
+
+    def send(self, msg: can.Message, timeout: float | None = None) -> None:
+        self._inner.send(msg, timeout)
+        time.sleep(0)
+
+    def _recv_internal(self, timeout: float | None) -> tuple[can.Message | None, bool]:
+        return self._inner.recv(timeout), False
+
+    def shutdown(self) -> None:
+        self._inner.shutdown()
+        super().shutdown()
+
+
+@pytest.fixture
+def channel() -> str:
+    return f"gimbal-test-{next(_channels)}"
+
+
+@pytest.fixture
+def listener(channel: str) -> Iterator[can.BusABC]:
+    bus = can.Bus(interface="virtual", channel=channel)
+    yield bus
+    bus.shutdown()
+
+
+def drain(bus: can.BusABC) -> list[can.Message]:
+    frames = []
+    while (frame := bus.recv(0)) is not None:
+        frames.append(frame)
+    return frames
+
+
+def test_packet_frames_cut_into_eights() -> None:
+    raw = bytes(range(26))
+    frames = packet_frames(raw, 0x223)
+    assert [len(f.data) for f in frames] == [8, 8, 8, 2]
+    assert b"".join(bytes(f.data) for f in frames) == raw
+    assert all(f.arbitration_id == 0x223 and not f.is_extended_id for f in frames)
+
+
+def test_send_and_receive_between_two_ends(channel: str) -> None:
+    host_bus = can.Bus(interface="virtual", channel=channel)
+    device_bus = can.Bus(interface="virtual", channel=channel)
+    try:
+        host, device = CanTransport(host_bus), CanTransport(device_bus, tx_id=0x222, rx_id=0x223)
+        command = message_packet(SpeedControl(10, 0, 0), 5)
+        host.send(command)
+        assert device.recv(1.0) == command
+        reply = message_packet(AnglesReply(0, 1, 2, 3, 4), 5)
+        device.send(encode_packet(reply))
+        assert host.recv(1.0) == reply
+        assert host.recv(0) is None
+    finally:
+        host_bus.shutdown()
+        device_bus.shutdown()
+
+
+def sent_packets(count: int, base_seq: int) -> list[Packet]:
+    push = ParameterPush(7, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
+    messages = [SpeedControl(1, 2, 3), push, AnglesReply(0, 1, 2, 3, 4)]
+    return [message_packet(messages[i % 3], base_seq + i) for i in range(count)]
+
+
+@pytest.mark.parametrize("shared_transport", [True, False])
+def test_concurrent_senders_never_interleave(channel: str, listener: can.BusABC, shared_transport: bool) -> None:
+    bus = YieldingBus(channel)
+    try:
+        transports = [CanTransport(bus)] * 2 if shared_transport else [CanTransport(bus), CanTransport(bus)]
+        work = [sent_packets(150, 0), sent_packets(150, 1000)]
+        threads = [threading.Thread(target=lambda t=t, w=w: [t.send(p) for p in w])
+                   for t, w in zip(transports, work)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        frames = drain(listener)
+    finally:
+        bus.shutdown()
+    # Each packet's frames must be consecutive: re-cut the frame sequence packet by packet.
+    expected = {encode_packet(p) for w in work for p in w}
+    index = 0
+    while index < len(frames):
+        raw = bytes(frames[index].data)
+        count = (decode_packet_length(raw) + 7) // 8
+        packet_bytes = b"".join(bytes(f.data) for f in frames[index:index + count])
+        assert packet_bytes in expected, f"frames interleaved at frame {index}"
+        expected.discard(packet_bytes)
+        index += count
+    assert not expected
+
+
+def decode_packet_length(first_frame: bytes) -> int:
+    return (first_frame[1] | first_frame[2] << 8) & 0x3FF
+
+
+def test_foreign_ids_and_odd_frames_are_ignored(channel: str) -> None:
+    bus = can.Bus(interface="virtual", channel=channel)
+    sender = can.Bus(interface="virtual", channel=channel)
+    try:
+        transport = CanTransport(bus)
+        reply = encode_packet(message_packet(AnglesReply(0, 1, 2, 3, 4), 9))
+        noise = [
+            can.Message(arbitration_id=0x530, data=b"\x55\xaa\x01\x02\x03\x04\x05\x06", is_extended_id=False),
+            can.Message(arbitration_id=0x426, data=b"\xaa\x1a\x00\x03", is_extended_id=False),
+            can.Message(arbitration_id=0x222, data=b"\xaa\x1a\x00\x03", is_extended_id=True),
+            can.Message(arbitration_id=0x223, data=b"\xaa\x1a\x00\x03", is_extended_id=False),
+            can.Message(arbitration_id=0x222, is_remote_frame=True, is_extended_id=False),
+        ]
+        for i, frame in enumerate(packet_frames(reply, 0x222)):
+            sender.send(noise[i % len(noise)])
+            sender.send(frame)
+        assert transport.recv(1.0) == decode_packet(reply)
+        assert transport.recv(0) is None
+        assert transport.foreign_frames == 4
+    finally:
+        bus.shutdown()
+        sender.shutdown()
+
+
+def test_corrupted_frames_surface_as_drops(channel: str) -> None:
+    bus = can.Bus(interface="virtual", channel=channel)
+    sender = can.Bus(interface="virtual", channel=channel)
+    try:
+        transport = CanTransport(bus)
+        good = encode_packet(message_packet(AnglesReply(0, 1, 2, 3, 4), 9))
+        bad = bytearray(good)
+        bad[17] ^= 0xFF
+        for raw in (bytes(bad), good):
+            for frame in packet_frames(raw, 0x222):
+                sender.send(frame)
+        first = transport.recv(1.0)
+        assert isinstance(first, Dropped) and first.reason == "crc32"
+        assert transport.recv(1.0) == decode_packet(good)
+    finally:
+        bus.shutdown()
+        sender.shutdown()
+
