@@ -1,6 +1,7 @@
 """One gimbal axis: uniform position moves, rate-limited speed control and hard stops at limits."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import Enum
 
@@ -66,7 +67,10 @@ class Axis:
         self.velocity = 0.0
 
     def advance(self, now: float, allowed: AxisRange) -> None:
-        """Integrate from the previous call to ``now``."""
+        """Integrate from the previous call to ``now`` (split exactly where a speed expires)."""
+        if self.mode is AxisMode.SPEED and self._last is not None and self._last < self._speed_until < now:
+            self.advance(self._speed_until, allowed)
+        commanded = self._last is not None and self._last < self._speed_until
         dt = 0.0 if self._last is None else max(0.0, now - self._last)
         self._last = now
         if self.mode is AxisMode.MOVE and self._move is not None:
@@ -78,11 +82,13 @@ class Axis:
                 self.mode = AxisMode.HOLD
                 self._move = None
         else:
-            wanted = self._speed if self.mode is AxisMode.SPEED and now < self._speed_until else 0.0
-            step = self.accel * dt
+            wanted = self._speed if self.mode is AxisMode.SPEED and commanded else 0.0
             before = self.velocity
-            self.velocity = min(wanted, before + step) if wanted > before else max(wanted, before - step)
-            self.angle += 0.5 * (before + self.velocity) * dt
+            ramp = min(dt, abs(wanted - before) / self.accel)  # exact: ramp, then constant speed
+            self.velocity = wanted if ramp < dt else before + math.copysign(self.accel * ramp, wanted - before)
+            self.angle += 0.5 * (before + self.velocity) * ramp + self.velocity * (dt - ramp)
+            if abs(self.velocity) < 1e-9:
+                self.velocity = 0.0
             if self.mode is AxisMode.SPEED and now >= self._speed_until and self.velocity == 0.0:
                 self.mode = AxisMode.HOLD
         self._apply_range(allowed)

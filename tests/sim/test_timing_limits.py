@@ -1,0 +1,118 @@
+"""Measured behaviour: the 0.5 s rule, push rate, limits, release, and the axis model itself."""
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from gimbal.errors import ReturnCodeError
+from gimbal.messages import motion, telemetry
+from gimbal.sim import SimConfig
+from gimbal.sim.dynamics import Axis, AxisRange
+from gimbal.sim.model import GimbalModel
+from tests.sim.helpers import wait_until
+
+
+def stop_time_after(sim, sent_at: float) -> float:  # type: ignore[no-untyped-def]
+    """Seconds from ``sent_at`` to the first snapshot at rest."""
+    assert wait_until(lambda: sim.state().moving, 0.2, step=0.002)
+    while sim.state().moving:
+        time.sleep(0.002)
+    return sim.state().time - sent_at
+
+
+def test_half_second_rule_measured(make_client) -> None:
+    client, sim = make_client()
+    sent_at = time.monotonic()
+    client.speed(20.0, 0.0)
+    stopped = stop_time_after(sim, sent_at)
+    assert 0.5 <= stopped <= 0.6, stopped
+    print(f"0.5 s rule: stopped {stopped:.3f} s after the last speed command")
+
+
+def test_zero_speed_stops_at_once_and_release_stops(make_client) -> None:
+    client, sim = make_client()
+    client.speed(36.0, 0.0)
+    time.sleep(0.1)
+    sent_at = time.monotonic()
+    client.speed(0.0, 0.0)
+    assert stop_time_after(sim, sent_at) < 0.1  # 36 °/s at 720 °/s² takes 50 ms
+    client.speed(36.0, 0.0)
+    time.sleep(0.1)
+    sent_at = time.monotonic()
+    client.speed(36.0, 0.0, take_control=False)
+    assert stop_time_after(sim, sent_at) < 0.1
+    assert not sim.state().speed_control
+
+
+@pytest.mark.parametrize("rate", [50.0, 20.0])
+def test_push_rate_within_ten_percent(make_client, rate: float) -> None:
+    client, sim = make_client(SimConfig(push_rate_hz=rate))
+    arrivals: list[float] = []
+    client.on_push(telemetry.ParameterPush, lambda m, t: arrivals.append(t))
+    client.set_push(True)
+    time.sleep(1.2)
+    client.set_push(False)
+    window = [t for t in arrivals if arrivals[0] + 0.1 <= t <= arrivals[0] + 1.1]
+    measured = (len(window) - 1) / (window[-1] - window[0])
+    assert abs(measured - rate) <= 0.1 * rate, measured
+    print(f"push rate: configured {rate} Hz, measured {measured:.1f} Hz")
+
+
+def test_position_beyond_limits_is_refused(make_client) -> None:
+    client, sim = make_client()
+    client.set_angle_limits(pitch_max=30, pitch_min=20, yaw_max=90, yaw_min=90, roll_max=30, roll_min=30)
+    for yaw, pitch in ((100.0, 0.0), (0.0, 35.0), (0.0, -25.0)):
+        with pytest.raises(ReturnCodeError) as err:
+            client.position(yaw, 0.0, pitch, time_s=0.2)
+        assert err.value.return_code == 0x02
+    client.position(80.0, 0.0, 0.0, time_s=0.2)
+    assert wait_until(lambda: sim.state().joint[0] == 80.0, 1.0)
+    with pytest.raises(ReturnCodeError):
+        client.position(20.0, 0.0, 0.0, absolute=False, time_s=0.2)  # relative: 100° > 90°
+    client.position(0.0, 0.0, 0.0, axes=("roll",), time_s=0.1)  # yaw flagged invalid: stays
+    time.sleep(0.2)
+    assert sim.state().joint[0] == 80.0
+
+
+def test_speed_stops_at_the_limit_and_new_limits_pull_back(make_client) -> None:
+    client, sim = make_client(SimConfig(initial_joint_deg=(0.0, 0.0, 40.0)))
+    client.set_angle_limits(pitch_max=45, pitch_min=55, yaw_max=179, yaw_min=179, roll_max=30, roll_min=30)
+    client.speed(0.0, 100.0)
+    time.sleep(0.2)
+    state = sim.state()
+    assert state.joint[2] == 45.0 and state.speeds[2] == 0.0
+    client.set_angle_limits(pitch_max=10, pitch_min=55, yaw_max=179, yaw_min=179, roll_max=30, roll_min=30)
+    assert wait_until(lambda: sim.state().joint[2] == 10.0, 1.0)
+
+
+def test_mechanical_ranges_and_continuous_yaw() -> None:
+    model = GimbalModel(SimConfig(yaw_continuous=True), 0.0)
+    assert model.handle(motion.PositionControl(0, 0, 1460, 1, 0), 0.0).return_code == 0x02  # > 145° limit
+    assert model.handle(motion.PositionControl(0, 0, 1450, 1, 0), 0.0).ok
+    assert model.handle(motion.PositionControl(0, 300, 0, 0x09, 0), 0.0).ok  # +30° roll, pitch invalid
+    model.advance(1.0)
+    assert model.joint() == (0.0, 30.0, 145.0)
+    assert model.handle(motion.PositionControl(1700, 0, 0, 0x0D, 0), 1.0).ok
+    model.advance(2.0)
+    assert model.handle(motion.PositionControl(200, 0, 0, 0x0C, 10), 2.0).ok  # +20° relative
+    model.advance(2.5)
+    assert model.joint()[0] == pytest.approx(-180.0)  # wrapped through +180
+    model.advance(3.0)
+    assert model.joint()[0] == pytest.approx(-170.0)
+
+
+def test_axis_acceleration_and_expiry_are_exact() -> None:
+    axis = Axis(0.0, max_speed=360.0, accel=720.0)
+    free = AxisRange(-180.0, 180.0)
+    axis.advance(0.0, free)
+    axis.set_speed(72.0, 0.0, hold_for=0.5)
+    axis.advance(0.05, free)
+    assert axis.velocity == pytest.approx(36.0) and axis.angle == pytest.approx(0.9)
+    axis.advance(0.5, free)
+    assert axis.velocity == pytest.approx(72.0)
+    axis.advance(0.55, free)
+    assert axis.velocity == pytest.approx(36.0)
+    axis.advance(0.6, free)
+    assert axis.velocity == 0.0 and axis.mode.value == "hold"
+    assert axis.angle == pytest.approx(0.5 * 72.0 * 0.1 + 72.0 * 0.4 + 0.5 * 72.0 * 0.1)
