@@ -93,7 +93,7 @@ def _open_log(path: str) -> Iterable[can.Message]:
         raise CliError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise CliError(f"{path}: is a directory, not a CAN log") from None
-    except (OSError, ValueError, ImportError) as exc:
+    except Exception as exc:  # unknown suffix (ValueError), bad header (BLFParseError, struct.error), ...
         raise CliError(f"{path}: cannot read as a CAN log: {exc}") from None
 
 
