@@ -5,6 +5,7 @@ had; ``finish`` always stops the gimbal (zero speed, release) before anything el
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from collections import Counter
@@ -49,7 +50,7 @@ class TrackOptions:
     controller: str = "pid"
     hfov_deg: float | None = None
     rate_hz: float = 25.0
-    max_speed_dps: float = 180.0
+    max_speed_dps: float | None = None  # None: the controller's default
     record: bool = False
     realtime: bool = False
     attitude_feedback: str = "auto"
@@ -70,6 +71,16 @@ class _Series:
     pitch_rate: list[float] = field(default_factory=list)
 
 
+def control_config(max_speed_dps: float | None) -> ControlConfig:
+    """The controller's defaults, with the speed limit the user chose; the acceleration limit is
+    raised only as far as the zero-speed ramp on loss needs to stay within it."""
+    base = ControlConfig()
+    if max_speed_dps is None:
+        return base
+    return dataclasses.replace(base, max_speed_dps=max_speed_dps,
+                               max_accel_dps2=max(base.max_accel_dps2, max_speed_dps / base.ramp_s))
+
+
 class TrackSession:
     """One tracking run against an open source and an open gimbal client."""
 
@@ -82,7 +93,7 @@ class TrackSession:
         width, height = source.size
         self.camera = CameraModel(width, height, hfov_deg=options.hfov_deg)
         self.controller = make_controller(options.controller, camera=self.camera,
-                                          config=ControlConfig(max_speed_dps=options.max_speed_dps))
+                                          config=control_config(options.max_speed_dps))
         self.tracker = make_tracker(options.tracker, options.model_dir)
         self.detector: Detector | None = (make_detector(options.detect, options.model_dir)
                                           if options.detect else None)

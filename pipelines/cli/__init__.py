@@ -11,8 +11,11 @@ from pipelines.cli.common import CliError
 
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
 SUBCOMMAND_MODULES = [
+    "pipelines.cli.track_cmd",
     "pipelines.cli.decode_cmd",
     "pipelines.cli.sim_cmd",
+    "pipelines.cli.gimbal_cmd",
+    "pipelines.cli.simulate_cmd",
 ]
 
 

@@ -1,0 +1,176 @@
+"""``gimbaltrack track SOURCE``: follow a subject in video and keep it framed with the gimbal."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from gimbal.client import GimbalClient, exit_on_signals
+from gimbal.errors import GimbalError, GimbalTimeoutError
+from pipelines.acquire import PICKS, parse_roi
+from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
+from pipelines.cli.common import CliError, add_bus_options
+from pipelines.control import ControlConfig, controller_names
+from pipelines.outputs.can_log import CanLogWriter, LoggingBus
+from pipelines.sources import FrameSource, SourceError, open_source
+from pipelines.track_session import FEEDBACK_MODES, TrackOptions, TrackSession
+from tracker import available_trackers
+
+EXIT_INTERRUPTED = 130
+DEFAULT_DETECTOR = "motion"
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "track", help="track a subject in video and keep it framed with the gimbal",
+        description="Track a subject in a video file, image folder, camera or stream, turn its "
+        "position into yaw/pitch rates (Kalman + PID) and stream them to the gimbal. With no bus "
+        "options the built-in simulated gimbal is used. Outputs (annotated video, telemetry, CAN "
+        "log, summary, plot) are written to --out as the run goes.",
+        epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
+        "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
+        "  gimbaltrack track udp://127.0.0.1:5000 --detect person --realtime",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("source", help="video file, image folder, camera index (e.g. 0) or stream URL "
+                        "(udp://, rtsp://, http://)")
+    subject = parser.add_argument_group("subject (default: --detect motion, the largest moving thing)")
+    start = subject.add_mutually_exclusive_group()
+    start.add_argument("--roi", help="x,y,w,h of the subject in the first frame, in pixels")
+    start.add_argument("--detect", choices=("face", "person", "motion"),
+                       help="find the subject with a detector (also used to re-acquire it)")
+    subject.add_argument("--pick", choices=PICKS, default="central",
+                         help="which detection to follow (default: central)")
+    subject.add_argument("--tracker", default="default",
+                         help=f"tracking backend: {', '.join(available_trackers())} (default: default)")
+    subject.add_argument("--model-dir", type=Path,
+                         help="folder with optional model files (NanoTrack, YuNet)")
+    control = parser.add_argument_group("control")
+    control.add_argument("--controller", choices=controller_names(), default="pid",
+                         help="pid: world-frame Kalman + PID + feed-forward (default); p: proportional baseline")
+    control.add_argument("--hfov", type=float, metavar="DEG",
+                         help="camera horizontal field of view (default: 24 mm lens on full frame, 73.7)")
+    control.add_argument("--rate", type=float, default=25.0, metavar="HZ",
+                         help="speed command rate (default: 25; one command lasts 0.5 s)")
+    control.add_argument("--max-speed", type=float, metavar="DEG_S",
+                         help=f"speed limit in deg/s (default: {ControlConfig().max_speed_dps:g}, at most 360)")
+    control.add_argument("--attitude-feedback", choices=FEEDBACK_MODES, default="auto",
+                         help="use the gimbal attitude (camera on the gimbal): auto = for live sources only")
+    run = parser.add_argument_group("run")
+    run.add_argument("--realtime", action="store_true", help="play files at their own frame rate")
+    run.add_argument("--fps", type=float, help="frame rate of an image folder (default: 30)")
+    run.add_argument("--record", action="store_true",
+                     help="start camera recording when the subject is acquired, stop it at the end")
+    run.add_argument("--max-frames", type=int, help="stop after this many frames")
+    run.add_argument("--out", type=Path, default=Path("out/track"), help="output folder (default: out/track)")
+    run.add_argument("--no-video", action="store_true", help="do not write the annotated video")
+    run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_bus_options(parser, default_interface="sim")
+    parser.set_defaults(func=run_track)
+
+
+def _options(args: argparse.Namespace) -> TrackOptions:
+    try:
+        roi = parse_roi(args.roi) if args.roi else None
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    if not args.rate > 0:
+        raise CliError("--rate must be positive")
+    if args.max_speed is not None and not 0 < args.max_speed <= 360:
+        raise CliError("--max-speed takes 0 < DEG_S <= 360 (the protocol's limit)")
+    if args.max_frames is not None and args.max_frames < 1:
+        raise CliError("--max-frames must be at least 1")
+    return TrackOptions(
+        out_dir=args.out, roi=roi, detect=args.detect or (None if roi else DEFAULT_DETECTOR),
+        pick=args.pick, tracker=args.tracker, model_dir=args.model_dir, controller=args.controller,
+        hfov_deg=args.hfov, rate_hz=args.rate, max_speed_dps=args.max_speed, record=args.record,
+        realtime=args.realtime, attitude_feedback=args.attitude_feedback,
+        max_frames=args.max_frames, video=not args.no_video, progress=not args.quiet)
+
+
+def run_track(args: argparse.Namespace) -> int:
+    options = _options(args)
+    try:
+        source = open_source(args.source, realtime=args.realtime, fps=args.fps)
+    except SourceError as exc:
+        raise CliError(str(exc)) from None
+    with source:
+        try:
+            options.out_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise CliError(f"cannot create output folder {options.out_dir}: {exc.strerror}") from None
+        can_log = CanLogWriter(options.out_dir / "can.log")
+        try:
+            with open_host_bus(args) as bus, LoggingBus(bus, can_log) as logged, \
+                    GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id) as client:
+                where = "built-in simulated gimbal" if args.interface == SIM_INTERFACE else bus.channel_info
+                session = _session(options, source, client, where)
+                return _run(session, args)
+        finally:
+            can_log.stop()
+
+
+def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, where: str) -> TrackSession:
+    try:
+        session = TrackSession(options, source, client, where)
+    except (ValueError, FileNotFoundError, OSError) as exc:
+        raise CliError(str(exc)) from None
+    try:
+        session.start()
+    except GimbalTimeoutError as exc:
+        session.finish("gimbal not answering", str(exc))
+        raise CliError(f"the gimbal does not answer on {where} ({exc}); check the "
+                       "wiring, bitrate (1 Mbit/s) and ids", exit_code=1) from None
+    return session
+
+
+def _run(session: TrackSession, args: argparse.Namespace) -> int:
+    try:
+        with exit_on_signals():
+            session.run()
+    except KeyboardInterrupt:
+        _report(session.finish("interrupted (SIGINT)"), args)
+        return EXIT_INTERRUPTED
+    except SystemExit as exc:
+        _report(session.finish("terminated (SIGTERM)"), args)
+        return int(exc.code or 1)
+    except SourceError as exc:
+        session.finish("source failed", str(exc))
+        raise CliError(f"{exc} (outputs so far are in {session.options.out_dir})", exit_code=1) from None
+    except (GimbalError, OSError) as exc:
+        session.finish("gimbal or bus failed", str(exc))
+        raise CliError(f"{exc} (the gimbal was told to stop; outputs so far are in "
+                       f"{session.options.out_dir})", exit_code=1) from None
+    _report(session.finish(), args)
+    return 0
+
+
+def _report(summary: dict[str, Any], args: argparse.Namespace) -> None:
+    if args.json:
+        print(json.dumps(summary, indent=2))
+        return
+    latency = summary["latency_ms"]
+    states = ", ".join(f"{k} {v}" for k, v in sorted(summary["states"].items()))
+    lines = [f"{summary['status']}: {summary['frames']} frames in {summary['elapsed_s']:.1f} s "
+             f"({summary['fps'] or 0:.1f} fps) from {summary['source']}",
+             f"subject: {states or 'never seen'}; tracker {summary['tracker']}, "
+             f"controller {summary['controller']}, bus {summary['bus']}"]
+    if latency["count"]:
+        lines.append(f"capture -> command latency: p50 {latency['p50']:.1f} ms, "
+                     f"p95 {latency['p95']:.1f} ms, p99 {latency['p99']:.1f} ms")
+    if summary["recording"]["requested"]:
+        lines.append(f"recording: {_recording_text(summary['recording'])}")
+    lines.append(f"outputs: {Path(summary['outputs']['summary']).parent}")
+    print("\n".join(lines), file=sys.stdout)
+
+
+def _recording_text(recording: dict[str, Any]) -> str:
+    if "started" not in recording:
+        return "not started (the subject was never acquired)"
+    if recording.get("error"):
+        return f"failed: {recording['error']}"
+    started = "started (confirmed)" if recording.get("start_confirmed") else "started (NOT confirmed)"
+    stopped = "stopped (confirmed)" if recording.get("stop_confirmed") else "stop NOT confirmed"
+    return f"{started}, {stopped}"
