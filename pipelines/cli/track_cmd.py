@@ -40,8 +40,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     start.add_argument("--roi", help="x,y,w,h of the subject in the first frame, in pixels")
     start.add_argument("--detect", choices=("face", "person", "motion"),
                        help="find the subject with a detector (also used to re-acquire it)")
-    subject.add_argument("--pick", choices=PICKS, default="central",
-                         help="which detection to follow (default: central)")
+    subject.add_argument("--pick", choices=PICKS,
+                         help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default)")
     subject.add_argument("--model-dir", type=Path,
@@ -82,9 +82,10 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError("--max-speed takes 0 < DEG_S <= 360 (the protocol's limit)")
     if args.max_frames is not None and args.max_frames < 1:
         raise CliError("--max-frames must be at least 1")
+    detect = args.detect or (None if roi else DEFAULT_DETECTOR)
     return TrackOptions(
-        out_dir=args.out, roi=roi, detect=args.detect or (None if roi else DEFAULT_DETECTOR),
-        pick=args.pick, tracker=args.tracker, model_dir=args.model_dir, controller=args.controller,
+        out_dir=args.out, roi=roi, detect=detect,
+        pick=args.pick or ("largest" if detect == "motion" else "central"), tracker=args.tracker, model_dir=args.model_dir, controller=args.controller,
         hfov_deg=args.hfov, rate_hz=args.rate, max_speed_dps=args.max_speed, record=args.record,
         realtime=args.realtime, attitude_feedback=args.attitude_feedback,
         max_frames=args.max_frames, video=not args.no_video, progress=not args.quiet)
