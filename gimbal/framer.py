@@ -25,6 +25,7 @@ class PacketFramer:
 
     def __init__(self, max_buffer: int = DEFAULT_MAX_BUFFER) -> None:
         self._buffer = bytearray()
+        self._scanned = 1  # offsets 1.._scanned-1 of the buffer cannot start a packet
         self._max_buffer = max(max_buffer, 1024)
         self.stats: Counter[str] = Counter()  # "packets" and one key per drop reason (in bytes)
 
@@ -53,6 +54,7 @@ class PacketFramer:
     def _drop(self, reason: str, count: int) -> Dropped:
         dropped = Dropped(reason, bytes(self._buffer[:count]))
         del self._buffer[:count]
+        self._scanned = 1
         self.stats[reason] += count
         return dropped
 
@@ -93,6 +95,7 @@ class PacketFramer:
             out.append(self._drop(exc.reason, length))
             return True
         del buf[:length]
+        self._scanned = 1
         self.stats["packets"] += 1
         out.append(packet)
         return True
@@ -121,14 +124,23 @@ class PacketFramer:
         return 0
 
     def _complete_packet_inside(self, end: int) -> int:
-        """Offset (> 0, < ``end``) of a whole packet with both CRCs valid; 0 when there is none."""
+        """Offset (> 0, < ``end``) of a whole packet with both CRCs valid; 0 when there is none.
+        Offsets already proven not to start a packet are not examined again."""
         buf = self._buffer
-        offset = buf.find(SOF, 1, end)
+        settled = True  # every offset before the current one is proven not to start a packet
+        offset = buf.find(SOF, self._scanned, end)
         while offset >= 0:
-            if self._header_at(offset):
+            header = self._header_at(offset)
+            if header:
                 length = declared_length(buf[offset:offset + 3])
                 if offset + length <= len(buf) and crc32(bytes(buf[offset:offset + length - 4])) == \
                         int.from_bytes(buf[offset + length - 4:offset + length], "little"):
                     return offset
+            if header is not False:
+                settled = False
+            elif settled:
+                self._scanned = offset + 1
             offset = buf.find(SOF, offset + 1, end)
+        if settled:
+            self._scanned = end
         return 0

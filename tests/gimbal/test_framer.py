@@ -79,6 +79,14 @@ def test_truncated_packet_is_reported_without_waiting_for_its_length() -> None:
     assert framer.pending == 0
 
 
+@given(st.integers(1, len(PUSH) - 1), st.integers(1, 9))
+def test_truncated_packet_then_packets_in_any_chunking(cut: int, size: int) -> None:
+    stream = PUSH[:cut] + REPLY + SPEED
+    items = feed_all([stream[i:i + size] for i in range(0, len(stream), size)])
+    assert packets(items) == [PACKETS[2], PACKETS[1]]
+    assert b"".join(data for _, data in drops(items)) == PUSH[:cut]
+
+
 def test_truncated_at_end_of_stream() -> None:
     framer = PacketFramer()
     assert packets(framer.feed(DOC_EXAMPLE + SPEED[:20])) == PACKETS[:1]
