@@ -1,0 +1,101 @@
+"""OTB and VOT ground truth, frame folders and video files."""
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from tracker.datasets import load_sequence, parse_groundtruth
+
+
+def _write_frames(folder: Path, count: int, name: str = "{:04d}.jpg") -> None:
+    folder.mkdir(parents=True, exist_ok=True)
+    for i in range(count):
+        cv2.imwrite(str(folder / name.format(i + 1)), np.full((24, 32, 3), i * 20, np.uint8))
+
+
+def test_otb_tab_and_comma_separated(tmp_path):
+    (tmp_path / "tab.txt").write_text("1\t2\t3\t4\n5\t6\t7\t8\n")
+    (tmp_path / "comma.txt").write_text("1,2,3,4\n5,6,7,8\n")
+    assert parse_groundtruth(tmp_path / "tab.txt") == ((1, 2, 3, 4), (5, 6, 7, 8))
+    assert parse_groundtruth(tmp_path / "comma.txt") == ((1, 2, 3, 4), (5, 6, 7, 8))
+
+
+def test_vot_polygon_becomes_axis_aligned_box(tmp_path):
+    (tmp_path / "gt.txt").write_text("334.0,128.0,438.0,188.0,396.0,260.0,292.0,200.0\n")
+    assert parse_groundtruth(tmp_path / "gt.txt") == ((292.0, 128.0, 146.0, 132.0),)
+
+
+def test_wrong_value_count_names_the_line(tmp_path):
+    (tmp_path / "gt.txt").write_text("1,2,3,4\n1,2,3\n")
+    with pytest.raises(ValueError, match=r"gt.txt:2"):
+        parse_groundtruth(tmp_path / "gt.txt")
+
+
+def test_otb_folder(tmp_path):
+    _write_frames(tmp_path / "seq" / "img", 3)
+    (tmp_path / "seq" / "groundtruth_rect.txt").write_text("1\t2\t3\t4\n" * 3)
+    seq = load_sequence(tmp_path / "seq")
+    assert (seq.name, len(seq)) == ("seq", 3)
+    frames = list(seq.frames())
+    assert len(frames) == 3 and frames[2][0, 0, 0] == 40
+
+
+@pytest.mark.parametrize("subdir", ["imgs", ""])
+def test_vot_folder_with_frames_in_imgs_or_directly(tmp_path, subdir):
+    _write_frames(tmp_path / "vot" / subdir if subdir else tmp_path / "vot", 2, "{:08d}.jpg")
+    (tmp_path / "vot" / "groundtruth.txt").write_text("0,0,10,0,10,5,0,5\n" * 2)
+    seq = load_sequence(tmp_path / "vot")
+    assert seq.groundtruth == ((0, 0, 10, 5), (0, 0, 10, 5))
+    assert len(list(seq.frames())) == 2
+
+
+def test_image_folder_without_groundtruth(tmp_path):
+    _write_frames(tmp_path, 4)
+    seq = load_sequence(tmp_path)
+    assert seq.groundtruth is None and len(seq) == 4
+
+
+def test_more_boxes_than_frames_is_an_error(tmp_path):
+    _write_frames(tmp_path / "img", 2)
+    (tmp_path / "groundtruth_rect.txt").write_text("1,2,3,4\n" * 3)
+    with pytest.raises(ValueError, match="only 2 frames"):
+        load_sequence(tmp_path)
+
+
+def _write_video(path: Path, count: int) -> None:
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 25, (32, 24))
+    for i in range(count):
+        writer.write(np.full((24, 32, 3), i * 30, np.uint8))
+    writer.release()
+
+
+def test_video_with_groundtruth_beside_it(tmp_path):
+    _write_video(tmp_path / "clip.avi", 5)
+    (tmp_path / "clip.txt").write_text("1,2,3,4\n" * 4)
+    seq = load_sequence(tmp_path / "clip.avi")
+    assert len(seq) == 4 and len(list(seq.frames())) == 4
+
+
+def test_video_with_given_groundtruth(tmp_path):
+    _write_video(tmp_path / "clip.avi", 3)
+    (tmp_path / "boxes.txt").write_text("0,0,4,0,4,4,0,4\n" * 3)
+    seq = load_sequence(tmp_path / "clip.avi", tmp_path / "boxes.txt")
+    assert seq.groundtruth[0] == (0, 0, 4, 4)
+
+
+def test_missing_path_and_empty_folder(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no such sequence"):
+        load_sequence(tmp_path / "nope")
+    with pytest.raises(ValueError, match="no image frames"):
+        load_sequence(tmp_path)
+
+
+def test_shared_sequences_load(shared_data):
+    for name in ("otb_crossing", "otb_surfer", "vot_bag", "vot15_ball1"):
+        seq = load_sequence(shared_data / "sequences" / name)
+        first = next(seq.frames())
+        assert first.ndim == 3 and len(seq) == len(seq.groundtruth) > 100
+    video = load_sequence(shared_data / "clips/clip_vot_bag_video/bag.avi",
+                          shared_data / "sequences/vot_bag/groundtruth.txt")
+    assert len(video) == 196

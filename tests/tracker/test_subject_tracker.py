@@ -1,0 +1,93 @@
+"""The subject tracker on rendered sequences: following, scale, loss and re-acquisition."""
+import numpy as np
+import pytest
+
+from tracker.registry import available_trackers, make_tracker
+from tracker.boxes import iou
+from tracker.estimate import TrackState
+from tracker.metrics import success_auc
+from tracker.synthetic import render_sequence
+
+FPS = 30.0
+
+
+def _track(name, seq, model_dir=None):
+    subject = make_tracker(name, model_dir)
+    first = subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    estimates = [first] + [subject.update(f, i / FPS) for i, f in enumerate(seq.frames[1:], 1)]
+    return estimates
+
+
+def test_available_trackers_lists_default_and_backends():
+    names = available_trackers()
+    assert names[0] == "default"
+    assert {"csrt-fast", "csrt", "kcf", "mil", "nano"} <= set(names)
+
+
+def test_default_follows_a_moving_target():
+    seq = render_sequence(frames=60, seed=4)
+    estimates = _track("default", seq)
+    assert success_auc([e.box for e in estimates], seq.boxes) > 0.7
+    assert all(e.state is TrackState.TRACKING for e in estimates)
+    assert [e.frame_index for e in estimates] == list(range(60))
+
+
+def test_velocity_is_in_pixels_per_second():
+    seq = render_sequence(frames=40, speed=3.0, seed=5)
+    vx, _ = _track("default", seq)[-1].velocity
+    assert vx == pytest.approx(3.0 * FPS, rel=0.35)
+
+
+@pytest.mark.parametrize("scale_change", [1.6, 0.7])
+def test_default_follows_scale_change(scale_change):
+    seq = render_sequence(frames=60, scale_change=scale_change, seed=2)
+    last = _track("default", seq)[-1]
+    assert last.box[2] == pytest.approx(seq.boxes[-1][2], rel=0.25)
+
+
+def test_full_occlusion_is_reported_and_the_target_reacquired():
+    seq = render_sequence(frames=80, occlusion=(25, 45), seed=1)
+    estimates = _track("default", seq)
+    hidden = [i for i, v in enumerate(seq.visible) if not v]
+    late_hidden = hidden[len(hidden) // 2:]
+    assert all(estimates[i].state is not TrackState.TRACKING for i in late_hidden)
+    assert max(estimates[i].confidence for i in late_hidden) < 0.3
+    assert any(estimates[i].state is TrackState.LOST for i in hidden)
+    # Back on the subject within 10 frames of it reappearing, and staying there.
+    back = hidden[-1] + 10
+    assert all(iou(e.box, b) > 0.5 for e, b in zip(estimates[back:], seq.boxes[back:]))
+    assert all(e.state is TrackState.TRACKING for e in estimates[-10:])
+    assert np.mean([e.confidence for e in estimates[-10:]]) > 0.5
+
+
+def test_lost_box_does_not_drift_away():
+    seq = render_sequence(frames=70, occlusion=(20, 60), seed=6)
+    estimates = _track("default", seq)
+    lost = [e for e in estimates if e.state is TrackState.LOST]
+    assert lost and np.ptp([e.box[0] for e in lost]) < 5
+
+
+def test_unknown_tracker_and_missing_model_files(tmp_path):
+    with pytest.raises(ValueError, match="unknown tracker 'nope'"):
+        make_tracker("nope")
+    with pytest.raises(FileNotFoundError, match="nanotrack_backbone"):
+        make_tracker("nano", tmp_path)
+    with pytest.raises(FileNotFoundError, match="model directory"):
+        make_tracker("nano")
+
+
+def test_update_before_init_is_an_error():
+    with pytest.raises(RuntimeError, match="before init"):
+        make_tracker().update(np.zeros((10, 10, 3), np.uint8), 0.0)
+
+
+def test_default_without_nanotrack_files_is_csrt_fast(tmp_path):
+    assert make_tracker("default", tmp_path).name == "csrt-fast"
+
+
+def test_nano_follows_and_is_default_with_model_files(shared_data):
+    models = shared_data / "models"
+    assert make_tracker("default", models).name == "nano"
+    seq = render_sequence(frames=50, seed=7)
+    estimates = _track("default", seq, models)
+    assert success_auc([e.box for e in estimates], seq.boxes) > 0.6

@@ -1,0 +1,105 @@
+"""Tracking backends: one small interface over OpenCV's trackers and NanoTrack."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Protocol
+
+import cv2
+import numpy as np
+
+from tracker.boxes import Box
+from tracker.model_files import find_model_file
+
+
+class TrackingBackend(Protocol):
+    """Follows one box from frame to frame; knows nothing about loss or re-acquisition."""
+
+    name: str
+
+    def init(self, frame: np.ndarray, box: Box) -> None:
+        """Start on ``box`` in ``frame``."""
+
+    def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
+        """The new box (``None`` when the backend gives up) and its own score in 0..1."""
+
+
+class OpenCvBackend:
+    """Any ``cv2.Tracker``; the score is 1 when it reports success, else 0 (or its own score)."""
+
+    def __init__(self, name: str, create: Callable[[], cv2.Tracker],
+                 score: Callable[[cv2.Tracker], float] | None = None) -> None:
+        self.name = name
+        self._create = create
+        self._score = score
+        self._tracker: cv2.Tracker | None = None
+
+    def init(self, frame: np.ndarray, box: Box) -> None:
+        self._tracker = self._create()
+        self._tracker.init(frame, _int_box(box))
+
+    def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
+        if self._tracker is None:
+            raise RuntimeError(f"{self.name}: update() before init()")
+        ok, box = self._tracker.update(frame)
+        if not ok:
+            return None, 0.0
+        score = self._score(self._tracker) if self._score else 1.0
+        return tuple(float(v) for v in box), float(np.clip(score, 0.0, 1.0))
+
+
+def _int_box(box: Box) -> tuple[int, int, int, int]:
+    x, y, w, h = box
+    return (int(round(x)), int(round(y)), max(1, int(round(w))), max(1, int(round(h))))
+
+
+def _csrt(**overrides: float | bool) -> Callable[[], cv2.Tracker]:
+    def create() -> cv2.Tracker:
+        params = cv2.TrackerCSRT_Params()
+        for key, value in overrides.items():
+            setattr(params, key, value)
+        return cv2.TrackerCSRT_create(params)
+    return create
+
+
+# CSRT with half the normalised template area and no colour segmentation: faster than OpenCV's
+# defaults at equal accuracy (docs/tracker.md). Fewer scale samples would be faster still but
+# breaks CSRT's scale estimation (tests/tracker/test_subject_tracker.py, scale change).
+FAST_CSRT = {"template_size": 100.0, "use_segmentation": False}
+
+
+def nanotrack_files(model_dir: str | Path | None) -> tuple[Path, Path]:
+    """NanoTrack's backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v2/``)."""
+    backbone = find_model_file(model_dir, "nanotrack_v2", "nanotrack_backbone*.onnx", "NanoTrack")
+    head = find_model_file(model_dir, "nanotrack_v2", "nanotrack_head*.onnx", "NanoTrack")
+    return backbone, head
+
+
+def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
+    backbone, head = nanotrack_files(model_dir)
+
+    def create() -> cv2.Tracker:
+        params = cv2.TrackerNano_Params()
+        params.backbone, params.neckhead = str(backbone), str(head)
+        return cv2.TrackerNano_create(params)
+    return create
+
+
+BACKEND_NAMES = ("csrt-fast", "csrt", "kcf", "mil", "mosse", "nano")
+
+
+def make_backend(name: str, model_dir: str | Path | None = None) -> TrackingBackend:
+    """A fresh backend by name (one of ``BACKEND_NAMES``); ``nano`` needs ``model_dir``."""
+    if name == "csrt-fast":
+        return OpenCvBackend(name, _csrt(**FAST_CSRT))
+    if name == "csrt":
+        return OpenCvBackend(name, _csrt())
+    if name == "kcf":
+        return OpenCvBackend(name, cv2.TrackerKCF_create)
+    if name == "mil":
+        return OpenCvBackend(name, cv2.TrackerMIL_create)
+    if name == "mosse":
+        return OpenCvBackend(name, cv2.legacy.TrackerMOSSE_create)
+    if name == "nano":
+        return OpenCvBackend(name, _nano(model_dir), score=lambda t: t.getTrackingScore())
+    raise ValueError(f"unknown tracking backend {name!r} (known: {', '.join(BACKEND_NAMES)})")

@@ -1,0 +1,135 @@
+"""Benchmark sequences: OTB and VOT folders, plain image folders and video files."""
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from tracker.boxes import Box, polygon_to_box
+
+IMAGE_SUFFIXES = {".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp"}
+VIDEO_SUFFIXES = {".avi", ".mp4", ".mov", ".mkv", ".webm", ".m4v", ".mpg", ".mpeg"}
+GROUNDTRUTH_NAMES = ("groundtruth_rect.txt", "groundtruth.txt")
+FRAME_DIRS = ("img", "imgs", "color")
+
+
+@dataclass(frozen=True)
+class Sequence:
+    """Frames (image files or one video) and, when known, one ground-truth box per frame."""
+
+    name: str
+    frame_paths: tuple[Path, ...] = ()
+    video_path: Path | None = None
+    groundtruth: tuple[Box, ...] | None = None
+
+    def __len__(self) -> int:
+        if self.groundtruth is not None:
+            return len(self.groundtruth)
+        if self.video_path is not None:
+            return _video_frame_count(self.video_path)
+        return len(self.frame_paths)
+
+    def frames(self) -> Iterator[np.ndarray]:
+        """The BGR frames in order (as many as there are ground-truth boxes, when known)."""
+        limit = len(self)
+        if self.video_path is not None:
+            yield from _read_video(self.video_path, limit)
+            return
+        for path in self.frame_paths[:limit]:
+            image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+            if image is None:
+                raise ValueError(f"cannot read image {path}")
+            yield image
+
+
+def parse_groundtruth(path: Path) -> tuple[Box, ...]:
+    """Boxes from an OTB ``x,y,w,h`` or VOT 8-value polygon file (comma, tab or space separated)."""
+    boxes: list[Box] = []
+    for number, line in enumerate(Path(path).read_text().splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            values = [float(v) for v in re.split(r"[,\s]+", line.strip())]
+        except ValueError:
+            raise ValueError(f"{path}:{number}: not numbers: {line.strip()!r}") from None
+        if len(values) == 4:
+            boxes.append((values[0], values[1], values[2], values[3]))
+        elif len(values) == 8:
+            boxes.append(polygon_to_box(values))
+        else:
+            raise ValueError(f"{path}:{number}: expected 4 (x,y,w,h) or 8 (polygon) values, got {len(values)}")
+    if not boxes:
+        raise ValueError(f"{path}: no ground-truth boxes")
+    return tuple(boxes)
+
+
+def load_sequence(path: str | Path, groundtruth: str | Path | None = None) -> Sequence:
+    """A sequence from a folder (OTB ``img/``, VOT ``imgs/`` or images directly) or a video file.
+
+    The ground truth is ``groundtruth`` when given, else a ``groundtruth_rect.txt`` /
+    ``groundtruth.txt`` found in the folder (beside a video: those names or ``<stem>.txt``).
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"no such sequence: {path}")
+    if path.is_file():
+        if path.suffix.lower() not in VIDEO_SUFFIXES:
+            raise ValueError(f"not a video file or sequence folder: {path}")
+        gt_path = Path(groundtruth) if groundtruth else _find_groundtruth(path.parent, path.stem + ".txt")
+        truth = parse_groundtruth(gt_path) if gt_path else None
+        if truth is not None and len(truth) > _video_frame_count(path):
+            raise ValueError(f"{gt_path} has {len(truth)} boxes but {path} has fewer frames")
+        return Sequence(path.stem, video_path=path, groundtruth=truth)
+    frames = _find_frames(path)
+    gt_path = Path(groundtruth) if groundtruth else _find_groundtruth(path)
+    truth = parse_groundtruth(gt_path) if gt_path else None
+    if truth is not None and len(truth) > len(frames):
+        raise ValueError(f"{gt_path} has {len(truth)} boxes but {path} has only {len(frames)} frames")
+    return Sequence(path.name, frame_paths=frames, groundtruth=truth)
+
+
+def _find_frames(folder: Path) -> tuple[Path, ...]:
+    for candidate in [folder / d for d in FRAME_DIRS] + [folder]:
+        if candidate.is_dir():
+            images = sorted(p for p in candidate.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+            if images:
+                return tuple(images)
+    raise ValueError(f"no image frames in {folder} (looked in {', '.join(FRAME_DIRS)} and the folder itself)")
+
+
+def _find_groundtruth(folder: Path, *extra_names: str) -> Path | None:
+    for name in (*GROUNDTRUTH_NAMES, *extra_names):
+        if (folder / name).is_file():
+            return folder / name
+    return None
+
+
+def _open_video(path: Path) -> cv2.VideoCapture:
+    capture = cv2.VideoCapture(str(path))
+    if not capture.isOpened():
+        raise ValueError(f"cannot open video {path}")
+    return capture
+
+
+def _video_frame_count(path: Path) -> int:
+    capture = _open_video(path)
+    try:
+        return int(capture.get(cv2.CAP_PROP_FRAME_COUNT))
+    finally:
+        capture.release()
+
+
+def _read_video(path: Path, limit: int) -> Iterator[np.ndarray]:
+    capture = _open_video(path)
+    try:
+        for _ in range(limit):
+            ok, frame = capture.read()
+            if not ok:
+                return
+            yield frame
+    finally:
+        capture.release()

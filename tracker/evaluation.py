@@ -1,0 +1,78 @@
+"""OTB-protocol evaluation: initialise on the first ground-truth box, never re-initialise."""
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from tracker.boxes import Box
+from tracker.datasets import Sequence
+from tracker.estimate import TargetEstimate, TrackState
+from tracker.metrics import precision_at, success_auc
+
+FRAME_RATE = 30.0  # timestamps given to the tracker for image sequences
+
+
+class Trackable(Protocol):
+    def init(self, frame: np.ndarray, box: Box, timestamp: float) -> object: ...
+
+    def update(self, frame: np.ndarray, timestamp: float) -> TargetEstimate: ...
+
+
+@dataclass(frozen=True)
+class SequenceResult:
+    """Scores of one tracker on one sequence."""
+
+    name: str
+    frames: int
+    prec20: float
+    auc: float
+    fps: float
+    boxes: list[Box] = field(repr=False, compare=False)
+
+    def as_dict(self) -> dict[str, object]:
+        return {"sequence": self.name, "frames": self.frames, "prec20": round(self.prec20, 4),
+                "auc": round(self.auc, 4), "fps": round(self.fps, 1)}
+
+
+def run_sequence(tracker: Trackable, sequence: Sequence,
+                 progress: Callable[[int, int], None] | None = None) -> SequenceResult:
+    """Track ``sequence`` and score it; a ``LOST`` estimate holds the last reported box.
+
+    Only ``update`` is timed (fps of the tracking step).
+    """
+    truth = sequence.groundtruth
+    if truth is None:
+        raise ValueError(f"{sequence.name}: no ground truth to evaluate against")
+    boxes: list[Box] = []
+    elapsed = 0.0
+    total = len(sequence)
+    for index, frame in enumerate(sequence.frames()):
+        timestamp = index / FRAME_RATE
+        if index == 0:
+            tracker.init(frame, truth[0], timestamp)
+            boxes.append(truth[0])
+        else:
+            start = time.perf_counter()
+            estimate = tracker.update(frame, timestamp)
+            elapsed += time.perf_counter() - start
+            boxes.append(boxes[-1] if estimate.state is TrackState.LOST else estimate.box)
+        if progress is not None:
+            progress(index + 1, total)
+    if len(boxes) != total:
+        raise ValueError(f"{sequence.name}: read {len(boxes)} frames, expected {total}")
+    fps = (total - 1) / elapsed if elapsed > 0 else float("inf")
+    return SequenceResult(sequence.name, total, precision_at(boxes, truth), success_auc(boxes, truth), fps, boxes)
+
+
+def summarize(results: list[SequenceResult]) -> dict[str, float]:
+    """Mean precision and AUC over sequences, median fps."""
+    if not results:
+        raise ValueError("no results to summarise")
+    return {"sequences": len(results),
+            "prec20": round(float(np.mean([r.prec20 for r in results])), 4),
+            "auc": round(float(np.mean([r.auc for r in results])), 4),
+            "fps": round(float(np.median([r.fps for r in results])), 1)}

@@ -1,0 +1,19 @@
+"""Finding optional model files in a user-given model directory."""
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def find_model_file(model_dir: str | Path | None, subdir: str, pattern: str, what: str) -> Path:
+    """The first file matching ``pattern`` in ``model_dir`` or ``model_dir/subdir``.
+
+    Raises ``FileNotFoundError`` naming the missing file and where it was looked for.
+    """
+    if model_dir is None:
+        raise FileNotFoundError(f"{what} needs model files: pass a model directory holding {pattern}")
+    root = Path(model_dir)
+    for folder in (root, root / subdir):
+        matches = sorted(folder.glob(pattern)) if folder.is_dir() else []
+        if matches:
+            return matches[0]
+    raise FileNotFoundError(f"{what}: no {pattern} in {root} or {root / subdir}")

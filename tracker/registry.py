@@ -1,0 +1,37 @@
+"""Tracker names and construction: ``make_tracker`` and ``available_trackers``."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from tracker.backends import BACKEND_NAMES, make_backend, nanotrack_files
+from tracker.subject import SubjectTracker
+
+DEFAULT_BACKEND = "csrt-fast"  # best measured without model files (docs/tracker.md)
+DEFAULT_WITH_MODELS = "nano"  # best measured when the NanoTrack files are given
+
+
+def available_trackers() -> list[str]:
+    """Names ``make_tracker`` accepts; ``nano`` also needs the NanoTrack model files."""
+    return ["default", *BACKEND_NAMES]
+
+
+def make_tracker(name: str = "default", model_dir: str | Path | None = None) -> SubjectTracker:
+    """A subject tracker by name.
+
+    ``default`` picks NanoTrack when ``model_dir`` holds its files, else the fast CSRT.
+    Unknown names raise ``ValueError``; missing model files raise ``FileNotFoundError``.
+    """
+    if name == "default":
+        name = DEFAULT_WITH_MODELS if model_dir is not None and _has_nanotrack(model_dir) else DEFAULT_BACKEND
+    if name not in BACKEND_NAMES:
+        raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
+    make_backend(name, model_dir)  # fails now, not on init(), when files are missing
+    return SubjectTracker(name, lambda: make_backend(name, model_dir))
+
+
+def _has_nanotrack(model_dir: str | Path) -> bool:
+    try:
+        nanotrack_files(model_dir)
+    except FileNotFoundError:
+        return False
+    return True

@@ -1,0 +1,118 @@
+"""SubjectTracker: a backend, a box Kalman filter, a confidence and re-acquisition."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from tracker.appearance import AppearanceModel, Match
+from tracker.backends import TrackingBackend
+from tracker.boxes import Box, clip_to_frame
+from tracker.detectors import Detector
+from tracker.estimate import TargetEstimate, TrackState
+from tracker.kalman import BoxKalman
+
+
+@dataclass(frozen=True)
+class TrackerSettings:
+    """Global thresholds (the same for every sequence; chosen on synthetic and benchmark data)."""
+
+    track_confidence: float = 0.25  # below this the backend's box is not trusted
+    reacquire_after_frames: int = 3  # low-confidence frames before a search may re-initialise
+    reacquire_score: float = 0.75  # template match needed to re-initialise on a found box
+    reacquire_margin: float = 0.3  # ... and by how much it must beat the backend's own box
+    adapt_confidence: float = 0.6  # the adaptive template learns only above this
+    adapt_rate: float = 0.05
+    lost_after_frames: int = 15  # consecutive low-confidence frames before declaring LOST
+    search_reach: float = 1.0  # local search radius in box sizes, growing while searching
+    max_reach: float = 4.0
+
+
+class SubjectTracker:
+    """Follows one subject; ``update`` returns a :class:`TargetEstimate` every frame.
+
+    Each frame the backend proposes a box; its confidence is the backend's own score times
+    the patch's likeness to the subject. Confident boxes feed the Kalman filter. Otherwise
+    the tracker searches (template matching around the Kalman prediction, then detector
+    candidates if it has a detector) and re-initialises the backend on a convincing match;
+    after ``lost_after_frames`` misses it reports ``LOST`` and holds the last box.
+    """
+
+    def __init__(self, name: str, make_backend: Callable[[], TrackingBackend],
+                 detector: Detector | None = None, settings: TrackerSettings | None = None) -> None:
+        self.name = name
+        self._make_backend = make_backend
+        self._detector = detector
+        self.settings = settings or TrackerSettings()
+        self._kalman = BoxKalman()
+        self._backend: TrackingBackend | None = None
+        self._appearance: AppearanceModel | None = None
+        self._size: tuple[float, float] = (0.0, 0.0)
+        self._misses = 0
+        self._frame_index = -1
+
+    def init(self, frame: np.ndarray, box: Box, timestamp: float) -> TargetEstimate:
+        """Start following ``box`` (x, y, w, h) in ``frame``."""
+        height, width = frame.shape[:2]
+        box = clip_to_frame(tuple(float(v) for v in box), width, height)
+        self._appearance = AppearanceModel(frame, box)
+        self._restart(frame, box, timestamp)
+        self._frame_index = 0
+        return self._estimate(1.0, TrackState.TRACKING, timestamp)
+
+    def update(self, frame: np.ndarray, timestamp: float) -> TargetEstimate:
+        """Follow the subject into ``frame`` captured at ``timestamp`` (seconds)."""
+        if self._backend is None or self._appearance is None:
+            raise RuntimeError("SubjectTracker.update() before init()")
+        self._frame_index += 1
+        s = self.settings
+        predicted = self._kalman.predict(timestamp)
+        box, backend_score = self._backend.update(frame)
+        similarity = self._appearance.similarity(frame, box) if box is not None else 0.0
+        confidence = backend_score * similarity
+        if box is not None and confidence >= s.track_confidence:
+            return self._accept(frame, box, confidence, timestamp)
+        self._misses += 1
+        found = self._search(frame, predicted) if self._misses >= s.reacquire_after_frames else Match(predicted, 0.0)
+        if found.score >= s.reacquire_score and found.score >= similarity + s.reacquire_margin:
+            self._restart(frame, found.box, timestamp)
+            return self._estimate(found.score, TrackState.TRACKING, timestamp)
+        if self._misses > s.lost_after_frames:
+            self._kalman.stop()
+            return self._estimate(confidence, TrackState.LOST, timestamp)
+        if box is not None:
+            self._kalman.correct(box, confidence)
+        return self._estimate(confidence, TrackState.SEARCHING, timestamp)
+
+    def _accept(self, frame: np.ndarray, box: Box, confidence: float, timestamp: float) -> TargetEstimate:
+        self._misses = 0
+        self._size = (box[2], box[3])
+        self._kalman.correct(box, confidence)
+        if confidence >= self.settings.adapt_confidence:
+            self._appearance.adapt(frame, box, self.settings.adapt_rate)
+        return self._estimate(confidence, TrackState.TRACKING, timestamp)
+
+    def _restart(self, frame: np.ndarray, box: Box, timestamp: float) -> None:
+        self._backend = self._make_backend()
+        self._backend.init(frame, box)
+        self._kalman.reset(box, timestamp)
+        self._size = (box[2], box[3])
+        self._misses = 0
+
+    def _search(self, frame: np.ndarray, predicted: Box) -> Match:
+        """Template search around the prediction, widening while the subject stays unseen."""
+        s = self.settings
+        reach = min(s.max_reach, s.search_reach * (1.0 + 0.25 * self._misses))
+        best = self._appearance.search(frame, predicted, self._size, reach)
+        if self._detector is not None and self._misses > s.lost_after_frames:
+            for detection in self._detector.detect(frame):
+                score = self._appearance.similarity(frame, detection.box)
+                if score > best.score:
+                    best = Match(detection.box, score)
+        return best
+
+    def _estimate(self, confidence: float, state: TrackState, timestamp: float) -> TargetEstimate:
+        box = self._kalman.box
+        return TargetEstimate(box=box, velocity=self._kalman.velocity, confidence=float(np.clip(confidence, 0, 1)),
+                              state=state, timestamp=timestamp, frame_index=self._frame_index)
