@@ -11,6 +11,7 @@ from pipelines.cli.common import CliError
 
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
 SUBCOMMAND_MODULES = [
+    "pipelines.cli.eval_cmd",
     "pipelines.cli.track_cmd",
     "pipelines.cli.decode_cmd",
     "pipelines.cli.sim_cmd",

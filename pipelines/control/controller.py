@@ -20,8 +20,8 @@ from tracker.estimate import TargetEstimate, TrackState
 class ControlConfig:
     """Limits, gains and timing of the closed loop (degrees, seconds)."""
 
-    max_speed_dps: float = 180.0
-    max_accel_dps2: float = 900.0
+    max_speed_dps: float = 120.0
+    max_accel_dps2: float = 600.0
     kp: float = 8.0  # deg/s per deg of error
     ki: float = 1.0
     kd: float = 0.0

@@ -153,7 +153,7 @@ def test_missing_attitude_is_dead_reckoned_from_the_setpoints():
 def test_config_validation_and_factory():
     with pytest.raises(ValueError):
         ControlConfig(max_speed_dps=400.0)
-    with pytest.raises(ValueError):  # 180 deg/s to zero in 0.1 s needs 1800 deg/s^2
+    with pytest.raises(ValueError):  # 120 deg/s to zero in 0.1 s needs 1200 deg/s^2
         ControlConfig(ramp_s=0.1, max_accel_dps2=900.0)
     assert controller_names() == ["pid", "p"]
     assert isinstance(make_controller(camera=CAM), RateController)

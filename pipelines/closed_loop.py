@@ -1,0 +1,169 @@
+"""The whole loop on a recorded sequence: virtual camera -> tracker -> controller -> GimbalClient
+-> CAN (python-can ``virtual``) -> simulated gimbal, whose attitude turns the virtual camera.
+
+Runs in real time (the client's keep-alive and the simulator run on the wall clock). Each frame
+is captured (rendered at the simulator's true attitude), handed to the tracker ``latency_s``
+later, and the setpoint goes out through the ``SpeedStreamer``; the ground truth in the view
+gives the centring error of every frame.
+"""
+from __future__ import annotations
+
+import time
+from collections import deque
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from gimbal.client import GimbalClient
+from gimbal.messages.telemetry import ParameterPush
+from gimbal.sim import SimConfig, start_in_process
+from pipelines.control.attitude import AttitudeHistory
+from pipelines.control.controller import ControlConfig, RateCommand, make_controller
+from pipelines.control.metrics import CentringSample, summarize
+from pipelines.virtual_camera import Box, VirtualCamera
+from tracker.datasets import load_sequence
+from tracker.estimate import TargetEstimate, TrackState
+
+ORACLE = "oracle"
+
+
+@dataclass(frozen=True)
+class LoopSettings:
+    controller: str = "pid"
+    tracker: str = ORACLE  # "oracle": the ground-truth box is the detection; else tracker.make_tracker
+    hfov_deg: float | None = None  # view field of view; None: crop-equivalent
+    out_size: tuple[int, int] = (640, 360)
+    latency_s: float = 0.0  # added between capture and tracking
+    fps: float = 30.0
+    control: ControlConfig = ControlConfig()
+
+
+@dataclass(frozen=True)
+class LoopStep:
+    """One frame: its centring sample (at capture) and the setpoint it produced."""
+
+    sample: CentringSample
+    command: RateCommand
+    attitude: tuple[float, float]  # true gimbal (yaw, pitch) at capture
+    processed_at: float  # seconds from the start
+
+
+@dataclass
+class LoopResult:
+    settings: LoopSettings
+    steps: list[LoopStep]
+    summary: dict[str, float | int | None]
+    command_latencies: list[float]  # capture -> first send on the bus, seconds
+
+
+class OracleTracker:
+    """The ground-truth view box as a perfect detection (LOST when its centre is out of view)."""
+
+    def __init__(self, width: int, height: int) -> None:
+        self.width, self.height = width, height
+
+    def estimate(self, box: Box | None, timestamp: float, index: int) -> TargetEstimate:
+        found = box is not None and 0 <= box[0] + box[2] / 2 < self.width and 0 <= box[1] + box[3] / 2 < self.height
+        return TargetEstimate(box or (0.0, 0.0, 0.0, 0.0), (0.0, 0.0), 1.0 if found else 0.0,
+                              TrackState.TRACKING if found else TrackState.LOST, timestamp, index)
+
+
+@dataclass
+class _Captured:
+    due: float
+    t: float
+    index: int
+    view: np.ndarray
+    box: Box | None
+    sample: CentringSample
+    attitude: tuple[float, float]
+
+
+def _make_tracker(name: str, model_dir: Path | None = None) -> object:
+    import tracker
+    if not hasattr(tracker, "make_tracker"):
+        raise ValueError(f"tracker {name!r} is not available here (only {ORACLE!r})")
+    return tracker.make_tracker(name, model_dir=model_dir)
+
+
+def _sleep_until(t: float) -> None:
+    delay = t - time.monotonic()
+    if delay > 0:
+        time.sleep(delay)
+
+
+def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> LoopResult:
+    """Run ``sequence`` (a folder or video with ground truth) through the loop; see the module doc."""
+    seq = load_sequence(sequence)
+    if seq.groundtruth is None:
+        raise ValueError(f"{sequence}: no ground truth, cannot measure centring")
+    frames: Iterator[np.ndarray] = seq.frames()
+    first = next(frames)
+    vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
+    controller = make_controller(settings.controller, camera=vc.camera, config=settings.control)
+    oracle = OracleTracker(vc.camera.width, vc.camera.height)
+    subject = None if settings.tracker == ORACLE else _make_tracker(settings.tracker)
+
+    host_bus, sim = start_in_process(SimConfig(yaw_continuous=True))
+    steps: list[LoopStep] = []
+    try:
+        with GimbalClient(host_bus) as client:
+            history = AttitudeHistory()
+            client.on_push(ParameterPush, history.on_push)
+            client.set_push(True)
+            client.wait_for_push(ParameterPush, 1.0)
+            streamer = client.speed_streamer()
+            pending: deque[_Captured] = deque()
+            t0 = time.monotonic() + 0.05
+            truth = iter(seq.groundtruth)
+
+            def process(item: _Captured) -> None:
+                if subject is None:
+                    est = oracle.estimate(item.box, item.t, item.index)
+                elif item.index == 0:
+                    subject.init(item.view, item.box, item.t)
+                    est = oracle.estimate(item.box, item.t, item.index)
+                else:
+                    est = subject.update(item.view, item.t)
+                att = history.at(item.t)
+                now = time.monotonic()
+                cmd = controller.update(est, None if att is None else (att.yaw, att.pitch), now)
+                streamer.set(cmd.yaw_dps, cmd.pitch_dps, stamp=item.t)
+                steps.append(LoopStep(item.sample, cmd, item.attitude, now - t0))
+
+            frame: np.ndarray | None = first
+            index = 0
+            while frame is not None or pending:
+                t_next = t0 + index / settings.fps if frame is not None else float("inf")
+                if pending and pending[0].due <= t_next:
+                    _sleep_until(pending[0].due)
+                    process(pending.popleft())
+                    continue
+                _sleep_until(t_next)
+                t_cap = time.monotonic()
+                yaw, _, pitch = sim.state().attitude
+                source_box = next(truth)
+                view = vc.render(frame, yaw, pitch)
+                box = vc.box_to_view(source_box, yaw, pitch)
+                pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box,
+                                         _sample(vc, source_box, yaw, pitch, t_cap - t0), (yaw, pitch)))
+                index += 1
+                frame = next(frames, None)
+            streamer.stop()
+            latencies = streamer.latencies()
+    finally:
+        sim.stop()
+        host_bus.shutdown()
+    return LoopResult(settings, steps, summarize([s.sample for s in steps]), latencies)
+
+
+def _sample(vc: VirtualCamera, box: Box, yaw: float, pitch: float, t: float) -> CentringSample:
+    x, y, w, h = box
+    (cx, cy), = vc.to_view(np.array([[x + w / 2, y + h / 2]]), yaw, pitch)
+    cam = vc.camera
+    if np.isnan(cx):
+        return CentringSample(t, 1.0, 0.0, False)
+    inside = 0.0 <= cx < cam.width and 0.0 <= cy < cam.height
+    return CentringSample(t, (cx - cam.cx) / cam.diagonal_px, (cy - cam.cy) / cam.diagonal_px, inside)
