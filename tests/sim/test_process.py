@@ -1,0 +1,132 @@
+"""The simulator as its own process (``gimbaltrack sim``) on udp_multicast, driven from this one."""
+from __future__ import annotations
+
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from gimbal.client import GimbalClient
+from gimbal.errors import GimbalError, ReturnCodeError
+from gimbal.messages.telemetry import ParameterPush
+from pipelines.cli import build_parser, main
+
+# Non-default ids keep this test apart from anything else on the shared multicast port.
+IDS = ["--tx-id", "0x323", "--rx-id", "0x322"]
+CLI = [sys.executable, "-c", "import sys; from pipelines.cli import main; sys.exit(main())"]
+
+
+def group() -> str:
+    return f"239.74.{random.randrange(1, 255)}.{random.randrange(1, 255)}"
+
+
+@pytest.fixture
+def sim_process() -> Iterator[tuple[subprocess.Popen[str], str]]:
+    channel = group()
+    proc = subprocess.Popen(CLI + ["sim", "-i", "udp_multicast", "-c", channel, *IDS,
+                                   "--status-interval", "0.2", "--push-rate", "40", "--version", "01.02.0A.0B"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=os.path.dirname(os.path.dirname(os.path.dirname(__file__))))
+    yield proc, channel
+    if proc.poll() is None:
+        proc.kill()
+        proc.communicate()
+
+
+def connect(channel: str) -> GimbalClient:
+    client = GimbalClient(interface="udp_multicast", channel=channel, tx_id=0x323, rx_id=0x322, timeout=0.1)
+    deadline = time.monotonic() + 5.0
+    while True:
+        try:
+            client.get_angles()
+            return client
+        except GimbalError:
+            if time.monotonic() > deadline:
+                client.close()
+                raise
+
+
+def test_two_processes_over_udp_multicast(sim_process) -> None:
+    proc, channel = sim_process
+    with connect(channel) as client:
+        assert client.version().version_text == "01.02.0A.0B"
+        client.position(20.0, 0.0, -10.0, time_s=0.3)
+        time.sleep(0.45)
+        joint = client.get_angles("joint")
+        assert (joint.yaw, joint.roll, joint.pitch) == (20.0, 0.0, -10.0)
+        client.start_recording()
+        assert client.camera_status() is True
+        arrivals: list[float] = []
+        client.on_push(ParameterPush, lambda m, t: arrivals.append(t))
+        client.set_push(True)
+        time.sleep(0.6)
+        client.set_push(False)
+        assert 0.85 * 40 * 0.5 <= len(arrivals) <= 1.15 * 40 * 0.6 + 1
+        with pytest.raises(ReturnCodeError):
+            client.position(170.0, 0.0, 145.5)  # pitch beyond the +145° user limit: refused
+        streamer = client.speed_streamer(rate_hz=25.0)
+        streamer.set(30.0, 0.0)
+        time.sleep(0.3)
+    time.sleep(0.3)  # leaving the client stopped the gimbal: the angle no longer changes
+    with connect(channel) as client:
+        first = client.get_angles("joint").yaw
+        time.sleep(0.2)
+        assert client.get_angles("joint").yaw == first
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=5)
+    assert proc.returncode == 0, err
+    lines = out.strip().splitlines()
+    assert len(lines) >= 3 and lines[-1].startswith("t=") and "rec=on" in lines[-1]
+
+
+def test_gimbal_cli_drives_the_simulator_process(sim_process) -> None:
+    if "gimbal" not in build_parser()._subparsers._group_actions[0].choices:  # type: ignore[union-attr]
+        pytest.skip("the 'gimbal' subcommand is not registered yet")
+    proc, channel = sim_process
+    bus = ["-i", "udp_multicast", "-c", channel, *IDS, "--timeout", "0.3"]
+
+    def gimbal(*args: str) -> None:
+        done = subprocess.run(CLI + ["gimbal", *args, *bus], capture_output=True, text=True, timeout=30)
+        assert done.returncode == 0, done.stderr
+
+    with connect(channel) as client:
+        gimbal("move", "--yaw", "15", "--pitch", "-5", "--time", "0.2")
+        gimbal("record", "start")
+        time.sleep(0.3)
+        joint = client.get_angles("joint")
+        assert (joint.yaw, joint.pitch) == (15.0, -5.0) and client.camera_status() is True
+
+
+def test_duration_status_lines_and_json(capsys) -> None:
+    assert main(["sim", "-i", "virtual", "-c", f"sim-cli-{os.getpid()}", "--duration", "0.35",
+                 "--status-interval", "0.1", "--json"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert 2 <= len(lines) <= 4
+    assert json.loads(lines[-1])["motors_on"] is True
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--drop", "1.5"], "Faults.drop is a fraction"),
+    (["--push-rate", "0"], "push_rate_hz must be positive"),
+    (["--duration", "-1"], "--duration must be positive"),
+    (["--tx-id", "0x222"], "must differ"),
+    (["-i", "sim"], "in-process simulator"),
+    (["-i", "no_such_interface"], "cannot open the CAN bus"),
+])
+def test_bad_input_is_a_one_line_error(capsys, args: list[str], message: str) -> None:
+    assert main(["sim", *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("args", [["--silent", "3:1"], ["--version", "1.2.3"], ["--fault-direction", "up"]])
+def test_malformed_options_are_usage_errors(capsys, args: list[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["sim", *args])
+    assert exc.value.code == 2
