@@ -71,6 +71,21 @@ def check_user_param(tlv: Tlv) -> None:
         raise RangeError(f"motor special byte 0x{value:02X}: only bit 0 (motors off) is defined")
 
 
+class _TlvPayload:
+    """For messages whose whole payload is a TLV buffer held in a ``tlvs`` field."""
+
+    NAME: ClassVar[str]
+    tlvs: tuple[Tlv, ...]
+
+    def encode_payload(self) -> bytes:
+        self.validate()
+        return encode_tlvs(self.tlvs)
+
+    @classmethod
+    def decode_payload(cls, payload: bytes) -> Self:
+        return cls(decode_tlvs(payload, cls.NAME))
+
+
 @dataclass
 class _TlvReply(Reply):
     """A return code followed by a TLV buffer."""
@@ -141,7 +156,7 @@ class SetUserParamsReply(_TlvReply):
 
 @register
 @dataclass
-class SetUserParams(Command):
+class SetUserParams(_TlvPayload, Command):
     """Write one or more user parameters (TLVs), e.g. ``motors_off(True)``."""
 
     CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
@@ -149,14 +164,6 @@ class SetUserParams(Command):
     NAME: ClassVar[str] = "set_user_params"
     REPLY: ClassVar = SetUserParamsReply
     tlvs: tuple[Tlv, ...] = field(default_factory=tuple)
-
-    def encode_payload(self) -> bytes:
-        self.validate()
-        return encode_tlvs(self.tlvs)
-
-    @classmethod
-    def decode_payload(cls, payload: bytes) -> Self:
-        return cls(decode_tlvs(payload, cls.NAME))
 
     def validate(self) -> None:
         if not self.tlvs:
@@ -179,7 +186,7 @@ class AutoCalibrationReply(Reply):
 
 @register
 @dataclass
-class AutoCalibration(Command):
+class AutoCalibration(_TlvPayload, Command):
     """Start or stop control-parameter auto-tuning (TLV 0x00), e.g. ``autotune(True)``."""
 
     CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
@@ -187,14 +194,6 @@ class AutoCalibration(Command):
     NAME: ClassVar[str] = "auto_calibration"
     REPLY: ClassVar = AutoCalibrationReply
     tlvs: tuple[Tlv, ...] = field(default_factory=lambda: (autotune(True),))
-
-    def encode_payload(self) -> bytes:
-        self.validate()
-        return encode_tlvs(self.tlvs)
-
-    @classmethod
-    def decode_payload(cls, payload: bytes) -> Self:
-        return cls(decode_tlvs(payload, cls.NAME))
 
     def validate(self) -> None:
         if not self.tlvs:
@@ -214,7 +213,7 @@ class AutoCalibration(Command):
 
 @register
 @dataclass
-class CalibrationStatusPush(DevicePush):
+class CalibrationStatusPush(_TlvPayload, DevicePush):
     """Auto-calibration progress: state (0 idle, 1 running, 2 done, 3 error) and 0..100 %."""
 
     CMD_SET: ClassVar[int] = GIMBAL_CMD_SET
@@ -225,14 +224,6 @@ class CalibrationStatusPush(DevicePush):
     @classmethod
     def of(cls, state: int, progress: int, error: bytes = bytes(4)) -> CalibrationStatusPush:
         return cls((Tlv(AUTOTUNE, bytes((state, progress)) + error),))
-
-    def encode_payload(self) -> bytes:
-        self.validate()
-        return encode_tlvs(self.tlvs)
-
-    @classmethod
-    def decode_payload(cls, payload: bytes) -> Self:
-        return cls(decode_tlvs(payload, cls.NAME))
 
     def validate(self) -> None:
         status = self._status_value()
