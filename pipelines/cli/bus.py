@@ -1,0 +1,70 @@
+"""The CAN bus a subcommand talks to a gimbal on: python-can's own, or the built-in simulator."""
+from __future__ import annotations
+
+import argparse
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import can
+
+from pipelines.cli.common import CliError
+
+SIM_INTERFACE = "sim"
+NO_INTERFACE = ("no CAN interface configured: pass -i/--interface (socketcan, slcan, pcan, gs_usb, "
+                "virtual, udp_multicast, ... or 'sim'), or set CAN_INTERFACE or ~/.canrc")
+
+
+def bus_options(args: argparse.Namespace) -> dict[str, Any]:
+    """``can.Bus`` keyword arguments from -i/-c/-b; unset ones are left out so that can.rc,
+    ``CAN_*`` variables and ``~/.canrc`` fill them in."""
+    given = {"interface": args.interface, "channel": args.channel, "bitrate": args.bitrate}
+    return {key: value for key, value in given.items() if value is not None}
+
+
+@contextmanager
+def open_host_bus(args: argparse.Namespace) -> Iterator[can.BusABC]:
+    """The host's bus for the subcommand; ``-i sim`` starts the simulated gimbal in-process.
+    Failures to open become one-line ``CliError``s; the bus is shut down on exit."""
+    if args.interface == SIM_INTERFACE:
+        with _simulated_gimbal() as bus:
+            yield bus
+        return
+    bus = _open(bus_options(args))
+    try:
+        yield bus
+    finally:
+        bus.shutdown()
+
+
+def _open(options: dict[str, Any]) -> can.BusABC:
+    try:
+        config = can.util.load_config(config=dict(options))
+    except can.CanInterfaceNotImplementedError as exc:
+        if '"None"' in str(exc):  # python-can's words when no source names an interface
+            raise CliError(NO_INTERFACE) from None
+        raise CliError(f"unknown CAN interface: {_one_line(exc)}") from None
+    where = f"{config['interface']} channel {config.get('channel')}"
+    try:
+        return can.Bus(**options)
+    except (can.CanError, OSError, ValueError, ImportError) as exc:
+        raise CliError(f"cannot open the CAN bus ({where}): {_one_line(exc)}") from None
+
+
+@contextmanager
+def _simulated_gimbal() -> Iterator[can.BusABC]:
+    try:
+        from gimbal.sim import start_in_process
+    except ImportError as exc:
+        raise CliError(f"the simulated gimbal is not available: {exc}") from None
+    host_bus, sim = start_in_process()
+    try:
+        yield host_bus
+    finally:
+        sim.stop()
+        host_bus.shutdown()
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip() or type(exc).__name__
+    return text.splitlines()[0]
