@@ -27,8 +27,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--controller", choices=controller_names(), default="pid",
                         help="pid (default: world-frame PID + feed-forward + latency compensation) "
                         "or p (speed proportional to pixel error, the public-driver baseline)")
-    parser.add_argument("--tracker", default=ORACLE,
-                        help=f"tracker name, or {ORACLE!r}: the ground-truth box is the detection (default)")
+    parser.add_argument("--tracker", default="default",
+                        help=f"tracker name (default: the project's default tracker), or {ORACLE!r}: "
+                        "the ground-truth box is the detection, isolating the control loop")
     parser.add_argument("--fps", type=float, default=30.0, help="playback frame rate (default 30)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
     parser.add_argument("--out", type=Path, metavar="DIR", help="write plot.png and summary.json here")
