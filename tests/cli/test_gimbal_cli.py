@@ -1,0 +1,177 @@
+"""``gimbaltrack gimbal ...`` through ``pipelines.cli.main`` against a scripted peer on the
+virtual bus (and the built-in simulator when it is present)."""
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+import uuid
+from collections.abc import Iterator
+from pathlib import Path
+
+import can
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "gimbal"))
+from scripted_peer import RELEASE, ZERO, ScriptedPeer, speed_messages  # noqa: E402
+
+from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply  # noqa: E402
+from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl  # noqa: E402
+from gimbal.messages.settings import (AngleLimitsReply, GetAngleLimits,  # noqa: E402
+                                      SetAngleLimits)
+from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv  # noqa: E402
+from pipelines.cli import main  # noqa: E402
+
+DOC_EXAMPLE = "AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE"
+
+
+@pytest.fixture
+def channel() -> str:
+    return f"cli-test-{uuid.uuid4().hex}"
+
+
+@pytest.fixture
+def peer(channel: str) -> Iterator[ScriptedPeer]:
+    bus = can.Bus(interface="virtual", channel=channel)
+    with ScriptedPeer(bus) as scripted:
+        yield scripted
+    bus.shutdown()
+
+
+def gimbal(channel: str, *args: str) -> int:
+    return main(["gimbal", *args, "-i", "virtual", "-c", channel])
+
+
+def test_print_packet_reproduces_the_documents_example(capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["gimbal", "move", "--yaw", "3.2", "--roll", "4.8", "--pitch", "6.4", "--absolute",
+                 "--time", "2", "--seq", "0x1122", "--print-packet"])
+    assert code == 0
+    assert capsys.readouterr().out.strip() == DOC_EXAMPLE
+
+
+def test_print_packet_for_a_query_uses_the_given_seq(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["gimbal", "angles", "--kind", "joint", "--seq", "1", "--print-packet"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert line.startswith("AA 13 00 03 00 00 00 00 01 00") and line.split()[12:15] == ["0E", "02", "02"]
+
+
+@pytest.mark.parametrize("args,words", [
+    (["move", "--yaw", "181"], "yaw_angle=1810 is outside -1800..1800"),
+    (["speed", "--pitch", "-400"], "pitch_speed=-4000 is outside"),
+    (["stiffness", "--pitch", "101", "--roll", "1", "--yaw", "1"], "pitch_stiffness=101"),
+    (["focus", "position", "5000"], "position=5000 is outside 0..4095"),
+    (["user-params", "--param-table", "3"], "param_table=3 is outside 0..2"),
+    (["move"], "give at least one of --yaw, --roll, --pitch"),
+])
+def test_out_of_range_values_are_one_line_errors_before_anything_is_sent(
+        channel: str, peer: ScriptedPeer, capsys: pytest.CaptureFixture[str], args: list[str],
+        words: str) -> None:
+    assert gimbal(channel, *args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("gimbaltrack gimbal: error:") and words in err
+    assert peer.received == []
+
+
+def test_angles_as_json(channel: str, peer: ScriptedPeer, capsys: pytest.CaptureFixture[str]) -> None:
+    peer.answer(GetAngles, lambda m: AnglesReply(0, m.ctrl_byte, 123 * m.ctrl_byte, -45, 900))
+    assert gimbal(channel, "angles", "--json") == 0
+    assert json.loads(capsys.readouterr().out) == {
+        "attitude": {"yaw": 12.3, "roll": -4.5, "pitch": 90.0},
+        "joint": {"yaw": 24.6, "roll": -4.5, "pitch": 90.0}}
+
+
+def test_angles_as_text_in_degrees(channel: str, peer: ScriptedPeer,
+                                   capsys: pytest.CaptureFixture[str]) -> None:
+    peer.answer(GetAngles, AnglesReply(0, 1, -1799, 0, 5))
+    assert gimbal(channel, "angles", "--kind", "attitude") == 0
+    assert capsys.readouterr().out.strip() == "attitude: yaw -179.9  roll 0.0  pitch 0.5"
+
+
+def test_setting_one_limit_keeps_the_others(channel: str, peer: ScriptedPeer,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    peer.answer(GetAngleLimits, AngleLimitsReply(0, 100, 40, 90, 80, 20, 10))
+    peer.answer(SetAngleLimits)
+    assert gimbal(channel, "limits", "--yaw-max", "45", "--json") == 0
+    assert peer.messages(SetAngleLimits) == [SetAngleLimits(1, 100, 40, 45, 80, 20, 10)]
+    assert json.loads(capsys.readouterr().out)["limits"]["yaw_max"] == 45
+
+
+def test_user_params_motors_off(channel: str, peer: ScriptedPeer,
+                                capsys: pytest.CaptureFixture[str]) -> None:
+    peer.answer(SetUserParams, SetUserParamsReply(0, (Tlv(0x23, b"\x01"),)))
+    assert gimbal(channel, "user-params", "--motors-off", "--json") == 0
+    assert peer.messages(SetUserParams)[0].tlvs == (Tlv(0x23, b"\x01"),)
+    assert json.loads(capsys.readouterr().out) == {"set": {"motors_off": 1}}
+
+
+def test_record_and_camera_status(channel: str, peer: ScriptedPeer,
+                                  capsys: pytest.CaptureFixture[str]) -> None:
+    peer.answer(CameraAction)
+    peer.answer(CameraStatusQuery, CameraStatusReply(0, 2))
+    assert gimbal(channel, "record", "start") == 0
+    assert gimbal(channel, "camera-status", "--json") == 0
+    assert peer.messages(CameraAction)[0].action == 0x0003
+    assert capsys.readouterr().out.splitlines() == ["ok", '{"recording": true}']
+
+
+def test_speed_streams_then_stops_and_releases(channel: str, peer: ScriptedPeer,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    peer.answer(SpeedControl)
+    assert gimbal(channel, "speed", "--yaw", "12.5", "--duration", "0.3", "--json") == 0
+    sent = speed_messages(peer)
+    assert sent[-2:] == [ZERO, RELEASE]
+    assert sent.count((125, 0, 0, 0x88)) >= 4  # resent while it lasted
+    assert json.loads(capsys.readouterr().out)["reply_timeouts"] == 0
+
+
+def test_silence_is_a_one_line_error(channel: str, peer: ScriptedPeer,
+                                     capsys: pytest.CaptureFixture[str]) -> None:
+    assert gimbal(channel, "camera-status", "--timeout", "0.05") == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "did not answer" in err
+
+
+def test_nack_is_a_one_line_error_with_its_meaning(channel: str, peer: ScriptedPeer,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    peer.nack(GetAngleLimits, 0x02)
+    assert gimbal(channel, "limits") == 1
+    assert "0x02 (command could not be executed)" in capsys.readouterr().err
+
+
+def test_no_interface_anywhere_is_a_clear_error(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(can, "rc", {})
+    monkeypatch.setenv("HOME", str(tmp_path))
+    for name in ("CAN_INTERFACE", "CAN_CHANNEL", "CAN_BITRATE", "CAN_CONFIG"):
+        monkeypatch.delenv(name, raising=False)
+    assert main(["gimbal", "angles"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no CAN interface configured" in err
+
+
+def test_python_can_environment_configuration_is_used(
+        channel: str, peer: ScriptedPeer, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setenv("CAN_INTERFACE", "virtual")
+    monkeypatch.setenv("CAN_CHANNEL", channel)
+    peer.answer(GetAngles, AnglesReply(0, 1, 10, 20, 30))
+    assert main(["gimbal", "angles", "--kind", "attitude", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["attitude"]["yaw"] == 1.0
+
+
+@pytest.mark.parametrize("args,words", [(["-i", "nosuchbus"], "unknown CAN interface"),
+                                        (["-i", "socketcan", "-c", "nosuchcan0"], "cannot open")])
+def test_bus_open_failures_are_one_line_errors(capsys: pytest.CaptureFixture[str], args: list[str],
+                                               words: str) -> None:
+    assert main(["gimbal", "angles", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+
+
+@pytest.mark.skipif(importlib.util.find_spec("gimbal.sim") is None, reason="gimbal.sim not built yet")
+def test_the_simulated_gimbal_answers(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["gimbal", "version", "-i", "sim", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["device_id"] == 1
+    assert main(["gimbal", "watch", "-i", "sim", "--duration", "0.3", "--json"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines and json.loads(lines[0])["push"] == "parameter_push"
