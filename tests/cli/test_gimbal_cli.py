@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import random
+import signal
+import subprocess
 import sys
 import uuid
 from collections.abc import Iterator
@@ -13,7 +16,7 @@ import can
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "gimbal"))
-from scripted_peer import RELEASE, ZERO, ScriptedPeer, speed_messages  # noqa: E402
+from scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages  # noqa: E402
 
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply  # noqa: E402
 from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl  # noqa: E402
@@ -175,3 +178,24 @@ def test_the_simulated_gimbal_answers(capsys: pytest.CaptureFixture[str]) -> Non
     assert main(["gimbal", "watch", "-i", "sim", "--duration", "0.3", "--json"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines and json.loads(lines[0])["push"] == "parameter_push"
+
+
+def test_sigterm_to_a_streaming_process_stops_and_releases() -> None:
+    """End to end in two processes over udp_multicast: the CLI streams speed, gets SIGTERM, and
+    its last words on the bus are zero speed and release."""
+    group = f"239.{random.randint(1, 254)}.{random.randint(1, 254)}.{random.randint(1, 254)}"
+    bus = can.Bus(interface="udp_multicast", channel=group)
+    with ScriptedPeer(bus) as peer:
+        peer.answer(SpeedControl)
+        child = subprocess.Popen([sys.executable, "-c", "import sys; from pipelines.cli import main; "
+                                  "sys.exit(main(sys.argv[1:]))", "gimbal", "speed", "--yaw", "15",
+                                  "--duration", "60", "-i", "udp_multicast", "-c", group],
+                                 stderr=subprocess.PIPE, text=True)
+        try:
+            peer.wait_for(SpeedControl, 3, timeout=20.0, where=lambda m: m.yaw_speed == 150)
+            child.send_signal(signal.SIGTERM)
+            assert child.wait(timeout=20.0) == 128 + signal.SIGTERM, child.stderr.read()
+        finally:
+            child.kill()
+        poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])
+    bus.shutdown()
