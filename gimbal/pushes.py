@@ -66,11 +66,6 @@ class PushHub:
         with self._cond:
             return self._latest.get(cls)  # type: ignore[return-value]
 
-    def count(self, cls: type[Message]) -> int:
-        """How many ``cls`` pushes arrived so far."""
-        with self._cond:
-            return self._counts[cls]
-
     def wait(self, cls: type[M], timeout: float) -> tuple[M, float]:
         """The next ``cls`` push to arrive after this call; ``GimbalTimeoutError`` after ``timeout`` s."""
         _check_push_class(cls)
