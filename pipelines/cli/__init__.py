@@ -15,6 +15,7 @@ SUBCOMMAND_MODULES = [
     "pipelines.cli.track_cmd",
     "pipelines.cli.decode_cmd",
     "pipelines.cli.replay_cmd",
+    "pipelines.cli.replay_cmd",
     "pipelines.cli.sim_cmd",
     "pipelines.cli.gimbal_cmd",
     "pipelines.cli.simulate_cmd",

@@ -1,0 +1,272 @@
+"""``gimbaltrack replay CANLOG``: a recorded session's DJI R SDK traffic, decoded packet by packet
+(``gimbal.log_decode``), with a summary; optionally the host's frames go out again onto a bus,
+timestamps honoured (scaled by ``--speed``)."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections import Counter
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import can
+
+from gimbal.client import SPEED_HOLD, SPEED_RELEASE, exit_on_signals
+from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
+from gimbal.messages import message_packet
+from gimbal.messages.motion import SPEED_TAKE_CONTROL, SpeedControl
+from gimbal.transport import CanTransport
+from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
+from pipelines.cli.common import CliError, add_bus_options
+from pipelines.cli.decode_cmd import _close, _next_frame, _open_log
+from pipelines.cli.sim_cmd import status_line
+
+ARROWS = {HOST_TO_GIMBAL: "host->gimbal", None: "?"}
+PUSH_KEY_FIELDS = ("yaw_angle", "roll_angle", "pitch_angle")  # a push's other fields rarely change
+STOP_SEQ = 0xFFF0  # SEQs of the safety stop sent after an interrupted replay
+SETTLE_S = 1.0  # how long the simulated gimbal may take to come to rest before its state is shown
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "replay", help="play a recorded CAN log back: decoded packets, a summary, optionally onto a bus",
+        description="Play a recorded session's CAN traffic (the can.log 'gimbaltrack track' writes, or "
+        "any log python-can reads) through the DJI R SDK decoder: one line per packet (time, direction, "
+        "name, key fields in degrees) and a summary. With -i the host->gimbal frames are sent onto that "
+        "bus at their recorded times ('-i sim': the built-in simulated gimbal, whose final state is "
+        "printed). An interrupted replay onto a bus ends with zero speed and control released.",
+        epilog="examples:\n  gimbaltrack replay out/track/can.log\n"
+        "  gimbaltrack replay out/track/can.log --json | jq .\n"
+        "  gimbaltrack replay out/track/can.log -i sim --speed 4\n"
+        "  gimbaltrack replay out/track/can.log -i socketcan -c can0",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("log", help="CAN log (candump .log, .asc, .blf, .csv, .trc, .db; .gz of those)")
+    parser.add_argument("--json", action="store_true",
+                        help="one decode JSON object per packet, then {\"summary\": ...}")
+    parser.add_argument("--realtime", action="store_true",
+                        help="print at the recorded pace (always on when sending onto a bus)")
+    parser.add_argument("--speed", type=float, default=1.0, metavar="X",
+                        help="playback speed factor for --realtime and bus output (default 1)")
+    add_bus_options(parser)
+    parser.set_defaults(func=run)
+
+
+@dataclass
+class ReplaySummary:
+    """What the log held: packets per name, errors, the speed command stream."""
+
+    packets: Counter[str] = field(default_factory=Counter)
+    errors: Counter[str] = field(default_factory=Counter)
+    out_of_range: int = 0
+    speed_times: list[float] = field(default_factory=list)
+    max_speed_dps: float = 0.0
+    last_speed: dict[str, int] | None = None
+    frames: int = 0
+    frames_sent: int = 0
+    first_t: float | None = None
+    last_t: float | None = None
+
+    def add(self, record: Record) -> None:
+        if "error" in record:
+            self.errors[record["error"]] += 1
+            return
+        self.packets[record["name"]] += 1
+        self.out_of_range += "out_of_range" in record
+        if record["name"] == "speed_control" and record["direction"] == HOST_TO_GIMBAL:
+            fields = record["fields"]
+            self.last_speed = fields
+            if record["timestamp"] is not None:
+                self.speed_times.append(record["timestamp"])
+            speeds = (fields.get(k, 0) for k in ("yaw_speed", "roll_speed", "pitch_speed"))
+            self.max_speed_dps = max(self.max_speed_dps, *(abs(v) / 10.0 for v in speeds))
+
+    @property
+    def holds_control(self) -> bool:
+        """True when the last speed command left the host in control (bit 7 set)."""
+        return self.last_speed is not None and bool(self.last_speed.get("ctrl_byte", 0) & SPEED_TAKE_CONTROL)
+
+    def speed_rate_hz(self) -> float | None:
+        t = self.speed_times
+        return (len(t) - 1) / (t[-1] - t[0]) if len(t) > 1 and t[-1] > t[0] else None
+
+    def as_dict(self) -> dict[str, Any]:
+        last = self.last_speed
+        return {"frames": self.frames, "frames_sent": self.frames_sent,
+                "duration_s": None if self.first_t is None else self.last_t - self.first_t,
+                "packets": dict(self.packets), "errors": dict(self.errors), "out_of_range": self.out_of_range,
+                "speed_commands": len(self.speed_times), "speed_rate_hz": self.speed_rate_hz(),
+                "max_speed_dps": self.max_speed_dps,
+                "last_speed": None if last is None else {
+                    "yaw_dps": last.get("yaw_speed", 0) / 10.0, "roll_dps": last.get("roll_speed", 0) / 10.0,
+                    "pitch_dps": last.get("pitch_speed", 0) / 10.0, "ctrl_byte": last.get("ctrl_byte"),
+                    "released": not self.holds_control}}
+
+    def text(self) -> str:
+        d = self.as_dict()
+        rate = d["speed_rate_hz"]
+        lines = [f"replayed {d['frames']} CAN frames over {d['duration_s'] or 0.0:.2f} s"
+                 + (f", sent {d['frames_sent']} host->gimbal frames" if d["frames_sent"] else ""),
+                 "packets: " + (", ".join(f"{n} {c}" for n, c in sorted(self.packets.items())) or "none"),
+                 f"speed commands: {d['speed_commands']}"
+                 + (f" at {rate:.1f} Hz" if rate else "") + f", max |speed| {d['max_speed_dps']:.1f} deg/s",
+                 "errors: " + (", ".join(f"{n} {c}" for n, c in sorted(self.errors.items())) or "none")
+                 + (f"; {self.out_of_range} out of range" if self.out_of_range else "")]
+        if last := d["last_speed"]:
+            lines.append(f"last speed command: yaw {last['yaw_dps']:+.1f} pitch {last['pitch_dps']:+.1f} "
+                         f"deg/s, control {'released' if last['released'] else 'HELD'}")
+        return "\n".join(lines)
+
+
+def format_record(record: Record, t0: float | None) -> str:
+    """One readable line: time since the first frame, direction, name, key fields in degrees."""
+    t = record.get("timestamp")
+    when = f"{t - t0:10.3f}" if t is not None and t0 is not None else f"{'-':>10}"
+    where = ARROWS.get(record["direction"], "gimbal->host")
+    if "error" in record:
+        return f"{when}  {where:<12}  ERROR {record['error']}: {record['detail']} [{record['hex']}]"
+    fields = record["fields"]
+    if record["kind"] == "push" and record["name"] == "parameter_push":
+        fields = {k: fields[k] for k in PUSH_KEY_FIELDS if k in fields}
+    text = " ".join(_field(k, v, record) for k, v in fields.items())
+    flag = f"  OUT OF RANGE: {record['out_of_range']}" if "out_of_range" in record else ""
+    return f"{when}  {where:<12}  {record['name']:<26} {text}{flag}".rstrip()
+
+
+def _field(name: str, value: Any, record: Record) -> str:
+    if isinstance(value, int) and name.endswith("_angle"):
+        return f"{name.removesuffix('_angle')}={value / 10.0:+.1f}deg"
+    if isinstance(value, int) and name.endswith("_speed"):
+        return f"{name.removesuffix('_speed')}={value / 10.0:+.1f}deg/s"
+    if name == "ctrl_byte" and isinstance(value, int):
+        return f"ctrl=0x{value:02X}"
+    if name == "return_code":
+        return f"rc={value} ({record.get('return_code_meaning', '?')})"
+    return f"{name}={value}"
+
+
+class _Pacer:
+    """Sleeps until a log timestamp's turn, the log's clock scaled by ``speed``."""
+
+    def __init__(self, speed: float) -> None:
+        self.speed = speed
+        self._origin: tuple[float, float] | None = None
+
+    def wait(self, timestamp: float) -> None:
+        if self._origin is None:
+            self._origin = (timestamp, time.monotonic())
+            return
+        log_t0, wall_t0 = self._origin
+        delay = wall_t0 + (timestamp - log_t0) / self.speed - time.monotonic()
+        if delay > 0:
+            time.sleep(delay)
+
+
+@contextmanager
+def _target(args: argparse.Namespace) -> Iterator[tuple[can.BusABC | None, Any]]:
+    """(bus to send onto or None, simulated gimbal for '-i sim' or None)."""
+    if args.interface is None:
+        yield None, None
+        return
+    if args.interface == SIM_INTERFACE:
+        from gimbal.sim import SimConfig, start_in_process
+        bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id))
+        try:
+            yield bus, sim
+        finally:
+            sim.stop()
+            bus.shutdown()
+        return
+    with open_host_bus(args) as bus:
+        yield bus, None
+
+
+def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
+    out = out or sys.stdout
+    if not args.speed > 0:
+        raise CliError(f"--speed must be positive, not {args.speed}")
+    if not Path(args.log).exists():  # python-can would complain about the suffix first
+        raise CliError(f"{args.log}: no such file")
+    summary = ReplaySummary()
+    with _target(args) as (bus, sim), exit_on_signals():
+        started = time.monotonic()
+        completed = False
+        try:
+            _replay(args, summary, bus, out)
+            completed = True
+        finally:
+            if bus is not None and summary.frames_sent and (not completed or summary.holds_control):
+                _stop_gimbal(bus, args.tx_id, args.rx_id)
+        _print(out, args.json, {"summary": summary.as_dict()}, summary.text())
+        if sim is not None:
+            state = _settled(sim)
+            _print(out, args.json, {"sim_state": state.as_dict()},
+                   "simulated gimbal at the end: " + status_line(state, time.monotonic() - started))
+    return 0
+
+
+def _settled(sim: Any) -> Any:
+    """The simulated gimbal's state once its axes stop (they decelerate at a finite rate)."""
+    deadline = time.monotonic() + SETTLE_S
+    state = sim.state()
+    while state.moving and time.monotonic() < deadline:
+        time.sleep(0.02)
+        state = sim.state()
+    return state
+
+
+def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | None, out: TextIO) -> None:
+    decoder = LogDecoder(args.tx_id, args.rx_id)
+    pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
+    reader = _open_log(args.log)
+    try:
+        iterator = iter(reader)
+        while (frame := _next_frame(iterator, args.log, summary.frames)) is not None:
+            summary.frames += 1
+            summary.first_t = frame.timestamp if summary.first_t is None else summary.first_t
+            summary.last_t = frame.timestamp
+            if pacer is not None:
+                pacer.wait(frame.timestamp)
+            if bus is not None and frame.arbitration_id == args.tx_id and not frame.is_extended_id:
+                _send(bus, frame)
+                summary.frames_sent += 1
+            _emit(decoder.feed_frame(frame), summary, args.json, out)
+    finally:
+        _close(reader)
+    _emit(decoder.finish(summary.last_t), summary, args.json, out)
+    if summary.frames == 0:
+        print(f"gimbaltrack replay: note: {args.log} holds no CAN frames", file=sys.stderr)
+
+
+def _send(bus: can.BusABC, frame: can.Message) -> None:
+    message = can.Message(arbitration_id=frame.arbitration_id, data=bytes(frame.data), is_extended_id=False)
+    try:
+        bus.send(message, timeout=0.05)
+    except can.CanError as exc:
+        raise CliError(f"the bus refused a frame: {exc}", exit_code=1) from None
+
+
+def _stop_gimbal(bus: can.BusABC, tx_id: int, rx_id: int) -> None:
+    """Best effort: zero speed, then zero with control released."""
+    transport = CanTransport(bus, tx_id, rx_id)
+    for offset, ctrl in enumerate((SPEED_HOLD, SPEED_RELEASE)):
+        try:
+            transport.send(message_packet(SpeedControl(0, 0, 0, ctrl), STOP_SEQ + offset))
+        except (can.CanError, OSError) as exc:
+            print(f"gimbaltrack replay: warning: could not send the stop: {exc}", file=sys.stderr)
+            return
+
+
+def _emit(records: list[Record], summary: ReplaySummary, as_json: bool, out: TextIO) -> None:
+    for record in records:
+        summary.add(record)
+        out.write(json.dumps(record) + "\n" if as_json else format_record(record, summary.first_t) + "\n")
+
+
+def _print(out: TextIO, as_json: bool, obj: dict[str, Any], text: str) -> None:
+    out.write(json.dumps(obj) + "\n" if as_json else text + "\n")
+    out.flush()
