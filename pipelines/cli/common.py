@@ -20,8 +20,13 @@ def parse_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
 
 
-def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | None = None) -> None:
-    """python-can's own options; unset values fall back to can.rc, CAN_* variables and ~/.canrc."""
+def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | None = None,
+                    repeated: bool = False) -> None:
+    """python-can's own options; unset values fall back to can.rc, CAN_* variables and ~/.canrc.
+
+    ``repeated`` adds them again to a command whose parent parser has them already: given there
+    they win, left out they keep the parent's value (``gimbal -i sim angles`` = ``gimbal angles -i sim``).
+    """
     group = parser.add_argument_group("CAN bus (python-can conventions)")
     group.add_argument(
         "-i", "--interface", default=default_interface,
@@ -34,3 +39,11 @@ def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | No
     group.add_argument("-b", "--bitrate", type=int, help="bitrate in bit/s (DJI RS gimbals use 1000000)")
     group.add_argument("--tx-id", type=parse_int, default=0x223, help="CAN id the host sends on (default 0x223)")
     group.add_argument("--rx-id", type=parse_int, default=0x222, help="CAN id the host listens on (default 0x222)")
+    if repeated:
+        suppress_defaults(group._group_actions)
+
+
+def suppress_defaults(actions: list[argparse.Action]) -> None:
+    """Let a subcommand's copy of an option leave the parent's value alone when not given."""
+    for action in actions:
+        action.default = argparse.SUPPRESS

@@ -33,7 +33,7 @@ from gimbal.messages.tlv_params import (ROLL360_MODES, AutoCalibration, Calibrat
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
 from pipelines.cli.bus import open_host_bus
-from pipelines.cli.common import CliError, add_bus_options, parse_int
+from pipelines.cli.common import CliError, add_bus_options, parse_int, suppress_defaults
 
 Result = dict[str, Any]
 LIMITS = ("pitch_max", "pitch_min", "yaw_max", "yaw_min", "roll_max", "roll_min")
@@ -461,18 +461,27 @@ COMMANDS = [
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser("gimbal", help="talk to a DJI RS gimbal: read, move, set, camera",
                                    description=__doc__)
+    _shared_options(parser)
     commands = parser.add_subparsers(dest="gimbal_command", metavar="COMMAND", required=True)
     for command in COMMANDS:
         sub = commands.add_parser(command.name, help=command.help, description=command.help)
         command.arguments(sub)
-        sub.add_argument("--json", action="store_true", help="print the result as JSON")
         sub.add_argument("--print-packet", action="store_true",
                          help="print the encoded packet(s) as hex and send nothing")
         sub.add_argument("--seq", type=parse_int, default=FIRST_SEQ,
                          help=f"SEQ for --print-packet (default 0x{FIRST_SEQ:04X})")
-        sub.add_argument("--timeout", type=float, default=0.1, help="reply timeout in s (default 0.1)")
-        add_bus_options(sub)
+        _shared_options(sub, repeated=True)
         sub.set_defaults(func=lambda args, command=command: run(command, args))
+
+
+def _shared_options(parser: argparse.ArgumentParser, repeated: bool = False) -> None:
+    """Options accepted before the command (``gimbal -i sim --json angles``) and after it."""
+    shared = [parser.add_argument("--json", action="store_true", help="print the result as JSON"),
+              parser.add_argument("--timeout", type=float, default=0.1,
+                                  help="reply timeout in s (default 0.1)")]
+    add_bus_options(parser, repeated=repeated)
+    if repeated:
+        suppress_defaults(shared)
 
 
 def run(command: Command, args: argparse.Namespace) -> int:

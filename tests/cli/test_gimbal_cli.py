@@ -199,3 +199,14 @@ def test_sigterm_to_a_streaming_process_stops_and_releases() -> None:
             child.kill()
         poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])
     bus.shutdown()
+
+
+def test_bus_and_output_options_work_before_or_after_the_command(capsys):
+    """The issue's own spelling is ``gimbal -i <iface> -c <chan> COMMAND``; both orders must work."""
+    from pipelines.cli import main
+
+    assert main(["gimbal", "-i", "sim", "--json", "version"]) == 0
+    before = json.loads(capsys.readouterr().out)
+    assert main(["gimbal", "version", "-i", "sim", "--json"]) == 0
+    after = json.loads(capsys.readouterr().out)
+    assert before == after == {"device_id": 1, "version": "02.05.00.00"}
