@@ -15,7 +15,6 @@ SUBCOMMAND_MODULES = [
     "pipelines.cli.track_cmd",
     "pipelines.cli.decode_cmd",
     "pipelines.cli.replay_cmd",
-    "pipelines.cli.replay_cmd",
     "pipelines.cli.sim_cmd",
     "pipelines.cli.gimbal_cmd",
     "pipelines.cli.simulate_cmd",
