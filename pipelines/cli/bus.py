@@ -8,6 +8,7 @@ from typing import Any
 
 import can
 
+from gimbal.sim import start_in_process
 from pipelines.cli.common import CliError
 
 SIM_INTERFACE = "sim"
@@ -53,10 +54,6 @@ def _open(options: dict[str, Any]) -> can.BusABC:
 
 @contextmanager
 def _simulated_gimbal() -> Iterator[can.BusABC]:
-    try:
-        from gimbal.sim import start_in_process
-    except ImportError as exc:
-        raise CliError(f"the simulated gimbal is not available: {exc}") from None
     host_bus, sim = start_in_process()
     try:
         yield host_bus
