@@ -1,0 +1,90 @@
+"""Benchmark the project's trackers against OpenCV's own on every shared sequence, in one run.
+
+Prints per-sequence success AUC, mean AUC, mean precision@20px, median fps of the tracking
+step (one thread) and ratios against OpenCV's CSRT measured alongside. Usage:
+
+    .venv/bin/python benchmarks/bench_trackers.py [--model-dir DIR] [--only NAME ...]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from tracker.backends import TrackingBackend, make_backend
+from tracker.boxes import Box
+from tracker.data_paths import shared_data_dir, shared_sequences
+from tracker.datasets import load_sequence
+from tracker.estimate import TargetEstimate, TrackState
+from tracker.evaluation import SequenceResult, run_sequence
+from tracker.registry import make_tracker
+
+BASELINE = "opencv-csrt"
+
+
+class BareBackend:
+    """An OpenCV tracker as it comes: no Kalman, confidence or re-acquisition."""
+
+    def __init__(self, backend: TrackingBackend) -> None:
+        self._backend = backend
+        self._index = 0
+
+    def init(self, frame: np.ndarray, box: Box, timestamp: float) -> None:
+        self._backend.init(frame, box)
+
+    def update(self, frame: np.ndarray, timestamp: float) -> TargetEstimate:
+        self._index += 1
+        box, score = self._backend.update(frame)
+        state = TrackState.LOST if box is None else TrackState.TRACKING
+        return TargetEstimate(box or (0.0, 0.0, 0.0, 0.0), (0.0, 0.0), score, state, timestamp, self._index)
+
+
+def contenders(model_dir: Path | None) -> dict[str, object]:
+    """Factories by label: OpenCV's trackers bare, then the project's subject trackers."""
+    table = {f"opencv-{n}": (lambda n=n: BareBackend(make_backend(n, model_dir))) for n in ("mil", "kcf", "csrt")}
+    table["gimbaltrack default (no models)"] = lambda: make_tracker("default")
+    if model_dir is not None:
+        table["opencv-nano"] = lambda: BareBackend(make_backend("nano", model_dir))
+        table["gimbaltrack default (models)"] = lambda: make_tracker("default", model_dir)
+    return table
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    default_models = shared_data_dir() / "models"
+    parser.add_argument("--model-dir", type=Path, default=default_models if default_models.is_dir() else None)
+    parser.add_argument("--only", nargs="*", help="labels to run (the CSRT baseline always runs)")
+    args = parser.parse_args(argv)
+    cv2.setNumThreads(1)
+    sequences = [load_sequence(p) for p in shared_sequences()]
+    if not sequences:
+        print(f"no sequences under {shared_data_dir() / 'sequences'}", file=sys.stderr)
+        return 2
+    table = contenders(args.model_dir)
+    labels = [k for k in table if not args.only or k == BASELINE or k in args.only]
+    results: dict[str, list[SequenceResult]] = {}
+    for label in labels:
+        print(f"running {label} ...", file=sys.stderr, flush=True)
+        results[label] = [run_sequence(table[label](), seq) for seq in sequences]
+    _print_table(results, [s.name for s in sequences])
+    return 0
+
+
+def _print_table(results: dict[str, list[SequenceResult]], names: list[str]) -> None:
+    base = results[BASELINE]
+    base_auc, base_fps = np.mean([r.auc for r in base]), np.median([r.fps for r in base])
+    short = [n.split("_", 1)[-1][:8] for n in names]
+    print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps | AUC / CSRT | fps / CSRT |")
+    print("|---" * (len(names) + 6) + "|")
+    for label, rows in results.items():
+        auc, fps = np.mean([r.auc for r in rows]), np.median([r.fps for r in rows])
+        cells = " | ".join(f"{r.auc:.2f}" for r in rows)
+        print(f"| {label} | {cells} | {auc:.3f} | {np.mean([r.prec20 for r in rows]):.3f} | {fps:.0f} "
+              f"| {auc / base_auc:.2f} | {fps / base_fps:.2f} |")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
