@@ -201,9 +201,11 @@ class TrackSession:
             record.update(estimate_fields(estimate))
             record["frame"] = frame.index
         record.update({"error_deg": [command.yaw_error_deg, command.pitch_error_deg],
-                       "rates_dps": [command.yaw_dps, command.pitch_dps], "mode": command.mode,
+                       "rate_dps": [command.yaw_dps, command.pitch_dps], "mode": command.mode,
                        "attitude_deg": None if attitude is None else
-                       [attitude.yaw, attitude.roll, attitude.pitch]})
+                       [attitude.yaw, attitude.pitch, attitude.roll],
+                       "attitude_t": None if attitude is None else attitude.timestamp,
+                       "dropped": self.source.dropped})
         self.telemetry.write(record)
         if self.video is not None:
             self.video.write(frame.image, estimate, (command.yaw_dps, command.pitch_dps),

@@ -93,6 +93,12 @@ def _options(args: argparse.Namespace) -> TrackOptions:
 
 def run_track(args: argparse.Namespace) -> int:
     options = _options(args)
+    # SIGTERM unwinds like Ctrl-C from here on: every ``with`` below stops the gimbal on the way out
+    with exit_on_signals():
+        return _open_and_run(options, args)
+
+
+def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
     try:
         source = open_source(args.source, realtime=args.realtime, fps=args.fps)
     except SourceError as exc:
@@ -120,6 +126,9 @@ def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, w
         raise CliError(str(exc)) from None
     try:
         session.start()
+    except (KeyboardInterrupt, SystemExit):
+        session.finish("interrupted while starting")
+        raise
     except GimbalTimeoutError as exc:
         session.finish("gimbal not answering", str(exc))
         raise CliError(f"the gimbal does not answer on {where} ({exc}); check the "
@@ -129,8 +138,7 @@ def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, w
 
 def _run(session: TrackSession, args: argparse.Namespace) -> int:
     try:
-        with exit_on_signals():
-            session.run()
+        session.run()
     except KeyboardInterrupt:
         _report(session.finish("interrupted (SIGINT)"), args)
         return EXIT_INTERRUPTED
@@ -144,6 +152,9 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
         session.finish("gimbal or bus failed", str(exc))
         raise CliError(f"{exc} (the gimbal was told to stop; outputs so far are in "
                        f"{session.options.out_dir})", exit_code=1) from None
+    except Exception as exc:  # a bug: keep the outputs and stop the gimbal, then let it show
+        session.finish("failed", repr(exc))
+        raise
     _report(session.finish(), args)
     return 0
 

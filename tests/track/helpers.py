@@ -1,0 +1,134 @@
+"""What the track tests share: synthetic clips, running the CLI, reading the recorded command stream."""
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import sys
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from gimbal.client import SPEED_RELEASE
+from gimbal.log_decode import HOST_TO_GIMBAL, decode_log_file
+from gimbal.messages.motion import SPEED_RANGE, SPEED_TAKE_CONTROL
+from pipelines.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+DEMO = ROOT / "samples" / "demo.mp4"
+DEMO_ROI = (ROOT / "samples" / "demo_roi.txt").read_text().strip()
+SIZE = (320, 240)
+BOX = 40  # the synthetic subject's side in pixels
+
+Position = Callable[[int], tuple[int, int] | None]  # frame index -> subject top-left, None: gone
+
+
+def make_clip(path: Path, frames: int, position: Position, fps: float = 30.0) -> Path:
+    """A Motion JPEG clip: a fixed textured background and a checkered square at ``position(i)``."""
+    rng = np.random.default_rng(7)
+    width, height = SIZE
+    background = cv2.GaussianBlur(rng.integers(60, 200, (height, width, 3), dtype=np.uint8), (5, 5), 0)
+    tile = np.indices((BOX, BOX)).sum(axis=0) // 8 % 2
+    subject = np.where(tile[..., None] == 1, (20, 40, 230), (240, 240, 30)).astype(np.uint8)
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), fps, SIZE)
+    assert writer.isOpened()
+    for i in range(frames):
+        image = background.copy()
+        where = position(i)
+        if where is not None:
+            x, y = where  # the square may stand partly outside the frame
+            visible = subject[:max(0, min(BOX, height - y)), :max(0, min(BOX, width - x))]
+            image[y:y + visible.shape[0], x:x + visible.shape[1]] = visible
+        writer.write(image)
+    writer.release()
+    return path
+
+
+def roi_at(position: Position) -> str:
+    x, y = position(0)  # type: ignore[misc]
+    return f"{x},{y},{BOX},{BOX}"
+
+
+def run_track(source: Path | str, out: Path, *extra: str) -> int:
+    """``gimbaltrack track`` in this process against the built-in simulator."""
+    return main(["track", str(source), "--out", str(out), "--quiet", *extra])
+
+
+def track_command(source: Path | str, out: Path, *extra: str) -> list[str]:
+    return [sys.executable, "-c", "import sys; from pipelines.cli import main; sys.exit(main())", "track", str(source), "--out", str(out), "--quiet", *extra]
+
+
+def subprocess_env(can_port: int | None = None) -> dict[str, str]:
+    """The environment for CLI subprocesses; ``can_port`` isolates udp_multicast traffic from
+    every other test on the machine (python-can reads ``CAN_CONFIG``)."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONUNBUFFERED": "1"}
+    if can_port is not None:
+        env["CAN_CONFIG"] = json.dumps({"port": can_port})
+    return env
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@dataclass(frozen=True)
+class SpeedCommand:
+    t: float
+    yaw: float  # deg/s
+    pitch: float
+    roll: float
+    ctrl: int
+
+    @property
+    def zero(self) -> bool:
+        return self.yaw == self.pitch == self.roll == 0.0
+
+    @property
+    def released(self) -> bool:
+        return not self.ctrl & SPEED_TAKE_CONTROL
+
+
+def decoded(can_log: Path) -> list[dict[str, Any]]:
+    return list(decode_log_file(str(can_log)))
+
+
+def host_commands(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    return [r for r in records if r["direction"] == HOST_TO_GIMBAL and "error" not in r]
+
+
+def speed_commands(records: Sequence[dict[str, Any]]) -> list[SpeedCommand]:
+    """Every speed command the host sent, in order, with values in °/s."""
+    out = []
+    for r in host_commands(records):
+        if r["name"] == "speed_control":
+            f = r["fields"]
+            out.append(SpeedCommand(r["timestamp"], f["yaw_speed"] / 10, f["pitch_speed"] / 10,
+                                    f["roll_speed"] / 10, f["ctrl_byte"]))
+    return out
+
+
+def assert_stopped_at_end(records: Sequence[dict[str, Any]]) -> None:
+    """The last speed command is zero with control released, after a zero still in control, and
+    nothing after it moves the gimbal (only camera commands may follow)."""
+    speeds = speed_commands(records)
+    assert speeds, "no speed command in the log"
+    assert speeds[-1].zero and speeds[-1].released and speeds[-1].ctrl == SPEED_RELEASE
+    assert speeds[-2].zero
+    motion = [r for r in host_commands(records) if r["cmd_set"] == 0x0E and r["name"] != "push_control"]
+    assert motion[-1]["name"] == "speed_control" and motion[-1]["fields"]["ctrl_byte"] == SPEED_RELEASE
+
+
+def in_speed_range(command: SpeedCommand) -> bool:
+    low, high = SPEED_RANGE
+    return all(low <= v * 10 <= high for v in (command.yaw, command.pitch, command.roll))
+
+
+def start(cmd: list[str], env: dict[str, str]) -> subprocess.Popen[str]:
+    return subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

@@ -1,0 +1,123 @@
+"""``gimbaltrack track`` end to end against the built-in simulator: the recorded command stream
+(rate, range, direction, final stop, camera recording), the outputs, and loss of the subject."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pytest
+
+from gimbal.messages.camera import CameraActionCode
+from pipelines.control import ControlConfig
+from pipelines.outputs.telemetry import read_telemetry
+from tests.track.helpers import (DEMO, DEMO_ROI, SIZE, assert_stopped_at_end, decoded,
+                                 host_commands, in_speed_range, make_clip, roi_at, run_track,
+                                 speed_commands)
+
+SUMMARY_KEYS = {"status", "error", "source", "live", "bus", "tracker", "controller", "frames", "elapsed_s",
+                "fps", "frames_dropped", "states", "first_acquired_s", "angular_error_deg", "latency_ms",
+                "speed_commands", "recording", "outputs"}
+
+
+@pytest.fixture(scope="module")
+def demo_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    out = tmp_path_factory.mktemp("demo")
+    code = run_track(DEMO, out, "--roi", DEMO_ROI, "--record")
+    return {"code": code, "out": out, "records": decoded(out / "can.log"),
+            "summary": json.loads((out / "summary.json").read_text())}
+
+
+def test_demo_run_succeeds_and_stops_the_gimbal(demo_run: dict[str, Any]) -> None:
+    assert demo_run["code"] == 0
+    assert demo_run["summary"]["status"] == "end of source"
+    assert_stopped_at_end(demo_run["records"])
+
+
+def test_speed_commands_keep_the_configured_rate_within_range(demo_run: dict[str, Any]) -> None:
+    """The keep-alive sends at least ``--rate`` (25 Hz) and, sending a new setpoint at once when
+    half a period has passed, at most twice that; never a gap near the gimbal's 0.5 s expiry."""
+    speeds = speed_commands(demo_run["records"])
+    streamed = speeds[:-2]  # the last two are the stop
+    times = np.array([c.t for c in streamed])
+    rate = (len(times) - 1) / (times[-1] - times[0])
+    assert 25 * 0.85 <= rate <= 2 * 25 * 1.05
+    assert np.diff(times).max() < 0.25
+    assert all(in_speed_range(c) for c in speeds)
+    assert max(max(abs(c.yaw), abs(c.pitch)) for c in speeds) <= ControlConfig().max_speed_dps
+    assert all(c.roll == 0 and c.ctrl == 0x88 for c in streamed)
+    assert not any(r.get("out_of_range") for r in host_commands(demo_run["records"]))
+
+
+def test_record_start_and_stop_are_sent_and_confirmed(demo_run: dict[str, Any]) -> None:
+    actions = [r["fields"]["action"] for r in host_commands(demo_run["records"]) if r["name"] == "camera_action"]
+    assert actions == [CameraActionCode.START_RECORDING, CameraActionCode.STOP_RECORDING]
+    recording = demo_run["summary"]["recording"]
+    assert recording["start_confirmed"] is True and recording["stop_confirmed"] is True
+
+
+def test_outputs_are_complete_and_readable(demo_run: dict[str, Any]) -> None:
+    out, summary = demo_run["out"], demo_run["summary"]
+    assert SUMMARY_KEYS <= summary.keys()
+    assert summary["frames"] == 270 and summary["states"]["tracking"] > 200
+    telemetry = read_telemetry(out / "telemetry.jsonl")
+    assert len(telemetry) == summary["frames"]
+    assert [r["frame"] for r in telemetry] == list(range(270))
+    assert all(len(r["rate_dps"]) == 2 and "error_deg" in r for r in telemetry)
+    video = cv2.VideoCapture(str(out / "annotated.avi"))
+    frames = 0
+    while video.read()[0]:
+        frames += 1
+    assert frames == summary["frames"]
+    plot = cv2.imread(str(out / "plot.png"))
+    assert plot is not None and plot.shape[0] > 100 and plot.std() > 0
+    assert summary["latency_ms"]["count"] > 50 and summary["latency_ms"]["p50"] > 0
+
+
+# Image axes: x grows to the right, y downwards. Controller: yaw positive to the right, pitch
+# positive upwards (pipelines.control.camera), so a subject below centre needs a negative pitch rate.
+@pytest.mark.parametrize("corner, signs, rate", [
+    ((230, 170), (1, -1), "25"),   # right of and below the centre
+    ((40, 20), (-1, 1), "10"),     # left of and above it, slower keep-alive
+])
+def test_commands_point_towards_the_subject(tmp_path: Path, corner: tuple[int, int],
+                                            signs: tuple[int, int], rate: str) -> None:
+    def position(i: int) -> tuple[int, int]:
+        return corner[0] + i % 3, corner[1]  # a slight jitter, well off centre
+
+    clip = make_clip(tmp_path / "clip.avi", 45, position)
+    assert run_track(clip, tmp_path / "out", "--roi", roi_at(position), "--no-video", "--rate", rate,
+                     "--realtime") == 0
+    records = decoded(tmp_path / "out" / "can.log")
+    moving = [c for c in speed_commands(records) if not c.zero]
+    assert len(moving) > 10
+    assert all(np.sign(c.yaw) == signs[0] and np.sign(c.pitch) == signs[1] for c in moving)
+    times = np.array([c.t for c in speed_commands(records)[:-2]])
+    assert float(rate) * 0.85 <= (len(times) - 1) / (times[-1] - times[0]) <= 2 * float(rate) * 1.05
+    assert_stopped_at_end(records)
+    assert not (tmp_path / "out" / "annotated.avi").exists()
+
+
+def test_rates_ramp_to_zero_when_the_subject_leaves(tmp_path: Path) -> None:
+    width = SIZE[0]
+
+    def position(i: int) -> tuple[int, int] | None:
+        x = 140 + 6 * i
+        return (x, 100) if x < width else None
+
+    gone = next(i for i in range(100) if position(i) is None)  # frame 30
+    clip = make_clip(tmp_path / "leaves.avi", 60, position)  # 2 s, gone after 1 s
+    assert run_track(clip, tmp_path / "out", "--roi", roi_at(position), "--no-video", "--realtime") == 0
+    telemetry = read_telemetry(tmp_path / "out" / "telemetry.jsonl")
+    lost_at = next(r for r in telemetry[1:] if r["state"] != "tracking")
+    assert lost_at["frame"] <= gone + 10, "the tracker did not notice the subject leave"
+    assert max(abs(v) for r in telemetry[: lost_at["frame"]] for v in r["rate_dps"]) > 50
+    deadline = lost_at["t_run"] + ControlConfig().stop_within_s + 0.02  # a frame's slack
+    after = [r for r in telemetry if r["t_run"] >= deadline]
+    assert len(after) > 10 and all(r["rate_dps"] == [0.0, 0.0] for r in after)
+    assert all(r["mode"] in ("hold", "ramp", "idle") for r in telemetry if r["t_run"] > lost_at["t_run"])
+    # the streamed commands end at rest too
+    speeds = speed_commands(decoded(tmp_path / "out" / "can.log"))
+    assert all(c.zero for c in speeds[-5:])
