@@ -2,11 +2,40 @@
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Sequence
 
+from tracker.boxes import iou
 from tracker.detectors import Detection
 
 PICKS = ("central", "largest")
+CAMERA_MOTION_FRACTION = 0.10  # motion over more of the frame than this: the camera moved
+
+
+class StartConfirmer:
+    """Starts on a detection only once it persists: seen (IoU >= ``min_iou``) in ``needed`` of the
+    last ``window`` usable frames. With ``max_moving_fraction`` (for the motion detector) frames
+    whose detections cover more of the image than that are skipped: the camera itself moved, so
+    a static-camera motion detector says nothing about the subject there."""
+
+    def __init__(self, needed: int = 3, window: int = 5, min_iou: float = 0.5,
+                 max_moving_fraction: float | None = None) -> None:
+        self.needed = needed
+        self.min_iou = min_iou
+        self.max_moving_fraction = max_moving_fraction
+        self._recent: deque[Sequence[Detection]] = deque(maxlen=window - 1)
+
+    def offer(self, detections: Sequence[Detection], frame_size: tuple[int, int]) -> list[Detection]:
+        """This frame's detections that are confirmed (empty until one persists)."""
+        width, height = frame_size
+        covered = sum(d.box[2] * d.box[3] for d in detections) / float(width * height)
+        if self.max_moving_fraction is not None and covered > self.max_moving_fraction:
+            return []
+        confirmed = [d for d in detections if 1 + sum(
+            any(iou(d.box, seen.box) >= self.min_iou for seen in frame) for frame in self._recent
+        ) >= self.needed]
+        self._recent.append(list(detections))
+        return confirmed
 
 
 def pick_candidate(detections: Sequence[Detection], frame_size: tuple[int, int],
