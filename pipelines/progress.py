@@ -9,8 +9,9 @@ from typing import TextIO
 class ProgressReporter:
     """Redraws one stderr line at most ``interval`` seconds apart (new lines when not a TTY)."""
 
-    def __init__(self, total: int | None, stream: TextIO = sys.stderr, interval: float = 0.25,
+    def __init__(self, total: int | None, stream: TextIO | None = None, interval: float = 0.25,
                  enabled: bool = True) -> None:
+        stream = stream or sys.stderr  # looked up now: sys.stderr may have been replaced since import
         self.total = total
         self.stream = stream
         self.interval = interval if stream.isatty() else max(interval, 2.0)

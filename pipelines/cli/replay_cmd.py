@@ -68,6 +68,7 @@ class ReplaySummary:
     last_speed: dict[str, int] | None = None
     frames: int = 0
     frames_sent: int = 0
+    echoes: int = 0  # host frames the bus looped back, skipped
     first_t: float | None = None
     last_t: float | None = None
 
@@ -96,7 +97,7 @@ class ReplaySummary:
 
     def as_dict(self) -> dict[str, Any]:
         last = self.last_speed
-        return {"frames": self.frames, "frames_sent": self.frames_sent,
+        return {"frames": self.frames, "frames_sent": self.frames_sent, "echoes_skipped": self.echoes,
                 "duration_s": None if self.first_t is None else self.last_t - self.first_t,
                 "packets": dict(self.packets), "errors": dict(self.errors), "out_of_range": self.out_of_range,
                 "speed_commands": len(self.speed_times), "speed_rate_hz": self.speed_rate_hz(),
@@ -110,7 +111,8 @@ class ReplaySummary:
         d = self.as_dict()
         rate = d["speed_rate_hz"]
         lines = [f"replayed {d['frames']} CAN frames over {d['duration_s'] or 0.0:.2f} s"
-                 + (f", sent {d['frames_sent']} host->gimbal frames" if d["frames_sent"] else ""),
+                 + (f", sent {d['frames_sent']} host->gimbal frames" if d["frames_sent"] else "")
+                 + (f" ({self.echoes} looped-back host frames skipped)" if self.echoes else ""),
                  "packets: " + (", ".join(f"{n} {c}" for n, c in sorted(self.packets.items())) or "none"),
                  f"speed commands: {d['speed_commands']}"
                  + (f" at {rate:.1f} Hz" if rate else "") + f", max |speed| {d['max_speed_dps']:.1f} deg/s",
@@ -222,10 +224,14 @@ def _settled(sim: Any) -> Any:
 def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | None, out: TextIO) -> None:
     decoder = LogDecoder(args.tx_id, args.rx_id)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
+    skip_echoes = _marks_sent_frames(args.log, args.tx_id)
     reader = _open_log(args.log)
     try:
         iterator = iter(reader)
         while (frame := _next_frame(iterator, args.log, summary.frames)) is not None:
+            if skip_echoes and frame.arbitration_id == args.tx_id and frame.is_rx:
+                summary.echoes += 1
+                continue
             summary.frames += 1
             summary.first_t = frame.timestamp if summary.first_t is None else summary.first_t
             summary.last_t = frame.timestamp
@@ -240,6 +246,18 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
     _emit(decoder.finish(summary.last_t), summary, args.json, out)
     if summary.frames == 0:
         print(f"gimbaltrack replay: note: {args.log} holds no CAN frames", file=sys.stderr)
+
+
+def _marks_sent_frames(path: str, tx_id: int) -> bool:
+    """True when the log marks the host's frames as sent (``T``): then host-id frames marked
+    received are the bus's echo of them (udp_multicast loops every frame back) and are skipped."""
+    reader = _open_log(path)
+    try:
+        return any(f.arbitration_id == tx_id and not f.is_rx for f in reader)
+    except Exception:  # noqa: BLE001 - an unreadable log is reported by the replay itself
+        return False
+    finally:
+        _close(reader)
 
 
 def _send(bus: can.BusABC, frame: can.Message) -> None:

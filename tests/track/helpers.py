@@ -11,11 +11,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import can
 import cv2
 import numpy as np
 
 from gimbal.client import SPEED_RELEASE
-from gimbal.log_decode import HOST_TO_GIMBAL, decode_log_file
+from gimbal.log_decode import HOST_TO_GIMBAL, decode_frames
+from gimbal.transport import HOST_TX_ID
 from gimbal.messages.motion import SPEED_RANGE, SPEED_TAKE_CONTROL
 from pipelines.cli import main
 
@@ -59,8 +61,13 @@ def run_track(source: Path | str, out: Path, *extra: str) -> int:
     return main(["track", str(source), "--out", str(out), "--quiet", *extra])
 
 
+def cli_command(*args: str) -> list[str]:
+    """``gimbaltrack ARGS`` as a subprocess command line, whatever is installed."""
+    return [sys.executable, "-c", "import sys; from pipelines.cli import main; sys.exit(main())", *args]
+
+
 def track_command(source: Path | str, out: Path, *extra: str) -> list[str]:
-    return [sys.executable, "-c", "import sys; from pipelines.cli import main; sys.exit(main())", "track", str(source), "--out", str(out), "--quiet", *extra]
+    return cli_command("track", str(source), "--out", str(out), "--quiet", *extra)
 
 
 def subprocess_env(can_port: int | None = None) -> dict[str, str]:
@@ -96,7 +103,10 @@ class SpeedCommand:
 
 
 def decoded(can_log: Path) -> list[dict[str, Any]]:
-    return list(decode_log_file(str(can_log)))
+    """The log's packets; host frames that came back marked ``R`` (udp_multicast loops every sent
+    frame back to the sender) are the bus's echo of the ``T`` ones and are left out."""
+    frames = [f for f in can.LogReader(str(can_log)) if not (f.arbitration_id == HOST_TX_ID and f.is_rx)]
+    return list(decode_frames(frames))
 
 
 def host_commands(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:

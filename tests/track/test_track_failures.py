@@ -1,0 +1,126 @@
+"""``gimbaltrack track`` when things go wrong: bad input, a bus that never answers or falls silent,
+and SIGINT/SIGTERM; every time a one-line error, a non-zero exit, the outputs kept and the
+gimbal told to stop."""
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+import gimbal.sim
+from gimbal.sim import Faults
+from pipelines.outputs.telemetry import read_telemetry
+from tests.track.helpers import (DEMO, DEMO_ROI, assert_stopped_at_end, cli_command, decoded, free_udp_port,
+                                 run_track, speed_commands, start, subprocess_env, track_command)
+
+GROUP = "239.74.163.9"
+
+
+def _one_line_error(capsys: pytest.CaptureFixture[str], *words: str) -> str:
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("gimbaltrack track: error:") and "Traceback" not in err
+    assert all(w in err for w in words), err
+    return err
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--roi", "1,2,x,4"], ["--roi"]),
+    (["--roi", "10,10,0,5"], ["w and h"]),
+    (["--tracker", "no-such-tracker"], ["no-such-tracker"]),
+    (["--max-speed", "400"], ["--max-speed"]),
+])
+def test_bad_options_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                         args: list[str], words: list[str]) -> None:
+    assert run_track(DEMO, tmp_path / "out", *args) == 2
+    _one_line_error(capsys, *words)
+
+
+def test_missing_and_garbage_sources(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert run_track(tmp_path / "nothing.mp4", tmp_path / "out") == 2
+    _one_line_error(capsys, "nothing.mp4")
+    garbage = tmp_path / "garbage.mp4"
+    garbage.write_bytes(bytes(range(256)) * 64)
+    assert run_track(garbage, tmp_path / "out") == 2
+    _one_line_error(capsys, "garbage.mp4")
+
+
+def test_a_gimbal_that_never_answers(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CAN_CONFIG", json.dumps({"port": free_udp_port()}))  # nobody else on it
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "-i", "udp_multicast", "-c", GROUP) == 1
+    _one_line_error(capsys, "does not answer")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "gimbal not answering" and summary["frames"] == 0
+    names = [r.get("name") for r in decoded(out / "can.log")]
+    assert "push_control" in names and "speed_control" not in names
+
+
+def test_a_bus_falling_silent_mid_run(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    real = gimbal.sim.start_in_process
+    monkeypatch.setattr(gimbal.sim, "start_in_process",
+                        lambda config=None, faults=None: real(config, Faults(silent=(1.0, 60.0))))
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("gimbaltrack track: error:") and "no reply" in err[-1]
+    assert "told to stop" in err[-1] and not any("Traceback" in line for line in err)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "gimbal or bus failed" and "no reply" in summary["error"]
+    assert 10 < summary["frames"] < 270
+    assert len(read_telemetry(out / "telemetry.jsonl")) == summary["frames"]
+    assert (out / "plot.png").stat().st_size > 0
+    records = decoded(out / "can.log")
+    assert_stopped_at_end(records)  # sent best effort although nobody listens any more
+    assert any(not c.zero for c in speed_commands(records))
+
+
+def _wait_for(predicate, timeout: float, what: str) -> None:  # type: ignore[no-untyped-def]
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.05)
+
+
+@pytest.mark.parametrize("signum, code, status", [
+    (signal.SIGINT, 130, "interrupted (SIGINT)"),
+    (signal.SIGTERM, 143, "terminated (SIGTERM)"),
+])
+def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signum: int, code: int,
+                                                      status: str) -> None:
+    """track and a ``gimbaltrack sim`` in separate processes on udp_multicast (a private port)."""
+    env = subprocess_env(free_udp_port())
+    sim = start(cli_command("sim", "-i", "udp_multicast", "-c", GROUP, "--status-interval", "0.1", "--json"),
+                env)
+    out = tmp_path / "out"
+    try:
+        _wait_for(lambda: sim.stdout.readline() != "", 10, "the simulator")  # type: ignore[union-attr]
+        track = start(track_command(DEMO, out, "--roi", DEMO_ROI, "--realtime", "-i", "udp_multicast",
+                                    "-c", GROUP), env)
+        telemetry = out / "telemetry.jsonl"
+        _wait_for(lambda: telemetry.exists() and len(telemetry.read_text().splitlines()) > 40, 20,
+                  "tracking")
+        track.send_signal(signum)
+        stdout, stderr = track.communicate(timeout=15)
+        assert track.returncode == code, stderr
+        assert "Traceback" not in stderr
+        time.sleep(0.5)  # the simulator decelerates (720 deg/s^2) and reports every 0.1 s
+    finally:
+        sim.send_signal(signal.SIGTERM)
+        sim_out, _ = sim.communicate(timeout=10)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == status and status in stdout
+    frames = summary["frames"]
+    assert 40 < frames < 270 and len(read_telemetry(out / "telemetry.jsonl")) == frames
+    assert (out / "plot.png").exists() and (out / "annotated.avi").stat().st_size > 0
+    records = decoded(out / "can.log")
+    assert any(not c.zero for c in speed_commands(records)), "the gimbal never moved"
+    assert_stopped_at_end(records)
+    final = json.loads(sim_out.strip().splitlines()[-1])
+    assert final["speeds"] == [0.0, 0.0, 0.0] and not final["moving"] and not final["speed_control"]
