@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 import gimbal.sim
+import pipelines.cli.bus
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
 from tests.track.helpers import (DEMO, DEMO_ROI, assert_stopped_at_end, cli_command, decoded, free_udp_port,
@@ -64,7 +65,7 @@ def test_a_gimbal_that_never_answers(tmp_path: Path, capsys: pytest.CaptureFixtu
 def test_a_bus_falling_silent_mid_run(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                       monkeypatch: pytest.MonkeyPatch) -> None:
     real = gimbal.sim.start_in_process
-    monkeypatch.setattr(gimbal.sim, "start_in_process",
+    monkeypatch.setattr(pipelines.cli.bus, "start_in_process",
                         lambda config=None, faults=None: real(config, Faults(silent=(1.0, 60.0))))
     out = tmp_path / "out"
     assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
