@@ -9,9 +9,13 @@ import copy
 import os
 import threading
 import time
+from collections import deque
 from typing import Any
 
 import can
+
+
+ECHO_WINDOW_S = 0.5  # how long a sent frame may take to come back as an echo
 
 
 class CanLogWriter(can.Listener):
@@ -51,6 +55,8 @@ class LoggingBus(can.BusABC):
 
     It owns the wrapped bus and the log: ``shutdown()`` shuts down the one and closes the other.
     Receive filters set on the proxy apply after logging, so the log holds all traffic read.
+    Some buses hand a sender its own frames back (python-can's udp_multicast always does, unlike
+    real adapters); such echoes of what this proxy sent are dropped, so each frame is seen once.
     """
 
     def __init__(self, bus: can.BusABC, log: CanLogWriter, **kwargs: Any) -> None:
@@ -59,19 +65,48 @@ class LoggingBus(can.BusABC):
         super().__init__(channel=None, **kwargs)
         self._can_protocol = bus.protocol
         self.channel_info = f"logged {bus.channel_info}"
+        self._sent: deque[tuple[float, int, bytes]] = deque()  # (expiry, id, data) of possible echoes
+        self._sent_lock = threading.Lock()
 
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         self._bus.send(msg, timeout)
+        now = time.monotonic()
+        with self._sent_lock:
+            self._forget_before(now)
+            self._sent.append((now + ECHO_WINDOW_S, msg.arbitration_id, bytes(msg.data)))
         sent = copy.copy(msg)
         sent.is_rx = False
         sent.timestamp = time.time()
         self._log.on_message_received(sent)
 
     def _recv_internal(self, timeout: float | None) -> tuple[can.Message | None, bool]:
-        msg = self._bus.recv(timeout)
-        if msg is not None:
-            self._log.on_message_received(msg)
-        return msg, False
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while True:
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+            msg = self._bus.recv(remaining)
+            if msg is None:
+                return None, False
+            if not self._is_echo(msg):
+                self._log.on_message_received(msg)
+                return msg, False
+            if deadline is not None and time.monotonic() >= deadline:
+                return None, False
+
+    def _is_echo(self, msg: can.Message) -> bool:
+        """Whether ``msg`` is a frame this proxy sent coming back (consumes the match)."""
+        now = time.monotonic()
+        data = bytes(msg.data)
+        with self._sent_lock:
+            self._forget_before(now)
+            for i, (_, can_id, sent_data) in enumerate(self._sent):
+                if can_id == msg.arbitration_id and sent_data == data:
+                    del self._sent[i]
+                    return True
+        return False
+
+    def _forget_before(self, now: float) -> None:
+        while self._sent and self._sent[0][0] < now:
+            self._sent.popleft()
 
     def shutdown(self) -> None:
         super().shutdown()

@@ -79,3 +79,22 @@ def test_writer_ignores_messages_after_stop(tmp_path: Path) -> None:
     log.on_message_received(_message(0x222, b"\x02"))
     assert log.count == 1
     assert path.read_text().split()[1:] == ["can1", "222#01", "R"]
+
+
+def test_a_bus_that_echoes_our_frames_logs_and_returns_each_frame_once(tmp_path):
+    """python-can's udp_multicast hands a sender its own frames back; a virtual bus with
+    receive_own_messages=True does the same, in-process."""
+    channel = f"echo-{uuid.uuid4().hex}"
+    path = tmp_path / "echo.log"
+    echoing = can.Bus(interface="virtual", channel=channel, receive_own_messages=True)
+    peer = can.Bus(interface="virtual", channel=channel)
+    with LoggingBus(echoing, CanLogWriter(path)) as bus:
+        for i in range(3):
+            bus.send(can.Message(arbitration_id=0x223, is_extended_id=False, data=[i, 1, 2]))
+        peer.send(can.Message(arbitration_id=0x222, is_extended_id=False, data=[9, 9]))
+        received = bus.recv(0.5)
+        assert received is not None and received.arbitration_id == 0x222
+        assert bus.recv(0.05) is None  # the three echoes were swallowed
+    peer.shutdown()
+    logged = list(can.LogReader(path))
+    assert [(m.arbitration_id, m.is_rx) for m in logged] == [(0x223, False)] * 3 + [(0x222, True)]
