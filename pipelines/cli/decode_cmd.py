@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import sys
 from collections.abc import Iterable, Iterator
@@ -87,12 +88,12 @@ def _next_frame(iterator: Iterator[can.Message], path: str, frames: int) -> can.
 
 
 def _open_log(path: str) -> Iterable[can.Message]:
+    if not os.path.exists(path):  # checked first: python-can judges the suffix before opening
+        raise CliError(f"{path}: no such file")
+    if os.path.isdir(path):
+        raise CliError(f"{path}: is a directory, not a CAN log")
     try:
         return can.LogReader(path)
-    except FileNotFoundError:
-        raise CliError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise CliError(f"{path}: is a directory, not a CAN log") from None
     except Exception as exc:  # unknown suffix (ValueError), bad header (BLFParseError, struct.error), ...
         raise CliError(f"{path}: cannot read as a CAN log: {exc}") from None
 
