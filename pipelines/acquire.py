@@ -37,6 +37,10 @@ class StartConfirmer:
         self._recent.append(list(detections))
         return confirmed
 
+    def reset(self) -> None:
+        """Forget what was seen: the next start must persist on its own."""
+        self._recent.clear()
+
 
 def pick_candidate(detections: Sequence[Detection], frame_size: tuple[int, int],
                    pick: str = "central", near: tuple[float, float] | None = None) -> Detection | None:

@@ -18,7 +18,7 @@ import numpy as np
 from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError
 from gimbal.messages import ParameterPush
-from pipelines.acquire import pick_candidate
+from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
 from pipelines.control import AttitudeHistory, CameraModel, ControlConfig, make_controller
 from pipelines.outputs.annotated_video import AnnotatedVideoWriter
 from pipelines.outputs.latency import latency_percentiles
@@ -57,7 +57,6 @@ class TrackOptions:
     max_frames: int | None = None
     video: bool = True
     progress: bool = True
-    redetect_every: int = 10
 
 
 @dataclass
@@ -97,6 +96,8 @@ class TrackSession:
         self.tracker = make_tracker(options.tracker, options.model_dir)
         self.detector: Detector | None = (make_detector(options.detect, options.model_dir)
                                           if options.detect else None)
+        self._confirmer = StartConfirmer(
+            max_moving_fraction=CAMERA_MOTION_FRACTION if options.detect == "motion" else None)
         self.feedback = (source.is_live if options.attitude_feedback == "auto"
                          else options.attitude_feedback == "on")
         self.history = AttitudeHistory()
@@ -168,8 +169,9 @@ class TrackSession:
             self._estimate = self.tracker.init(frame.image, box, stamp)
             return self._estimate
         estimate = self.tracker.update(frame.image, stamp)
-        if (estimate.state is TrackState.LOST and self.detector is not None
-                and self.frames % self.options.redetect_every == 0):
+        if estimate.state is not TrackState.LOST:
+            self._confirmer.reset()  # a re-acquisition must persist from the loss on
+        elif self.detector is not None:
             box = self._detect(frame, estimate.center)
             if box is not None:
                 estimate = self.tracker.init(frame.image, box, stamp)
@@ -177,10 +179,13 @@ class TrackSession:
         return estimate
 
     def _detect(self, frame: Frame, near: tuple[float, float] | None) -> tuple[float, ...] | None:
+        """A confirmed detection to (re)start on: the pick rule for a start, nearest ``near`` for
+        a re-acquisition. Runs on every frame while acquiring or lost (the motion detector needs
+        consecutive frames)."""
         if self.detector is None:
             return None
-        found = pick_candidate(self.detector.detect(frame.image), self.source.size,
-                               self.options.pick, near)
+        confirmed = self._confirmer.offer(self.detector.detect(frame.image), self.source.size)
+        found = pick_candidate(confirmed, self.source.size, self.options.pick, near)
         return None if found is None else tuple(found.box)
 
     def _attitude_at(self, stamp: float) -> tuple[float, float] | None:
