@@ -112,7 +112,9 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
         try:
             with open_host_bus(args) as bus, LoggingBus(bus, can_log) as logged, \
                     GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id) as client:
-                where = "built-in simulated gimbal" if args.interface == SIM_INTERFACE else bus.channel_info
+                where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
+                         " ".join(str(v) for v in (args.interface or "python-can's configured bus",
+                                                   args.channel) if v))
                 session = _session(options, source, client, where)
                 return _run(session, args)
         finally:

@@ -69,11 +69,18 @@ class LoggingBus(can.BusABC):
         self._sent_lock = threading.Lock()
 
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
-        self._bus.send(msg, timeout)
         now = time.monotonic()
-        with self._sent_lock:
+        entry = (now + ECHO_WINDOW_S, msg.arbitration_id, bytes(msg.data))
+        with self._sent_lock:  # before sending: the echo may be read before send() returns
             self._forget_before(now)
-            self._sent.append((now + ECHO_WINDOW_S, msg.arbitration_id, bytes(msg.data)))
+            self._sent.append(entry)
+        try:
+            self._bus.send(msg, timeout)
+        except BaseException:
+            with self._sent_lock:
+                if entry in self._sent:
+                    self._sent.remove(entry)
+            raise
         sent = copy.copy(msg)
         sent.is_rx = False
         sent.timestamp = time.time()
