@@ -147,7 +147,7 @@ class SpeedStreamer:
                 return  # stop() or halt() raced with a send: nothing is lost
             self.error = exc
             self._halt.set()
-            log.error("speed streaming stopped: %s", exc)
+            log.warning("speed streaming stopped: %s", exc)  # the next set() raises it
             self._client.stop_and_release()
         finally:
             if pending is not None:

@@ -27,6 +27,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Keep a subject framed with a DJI RS gimbal: track it in video, "
         "turn its position into yaw/pitch rates, and drive the gimbal over CAN (DJI R SDK).",
     )
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="log warnings too (retries, timeouts, best-effort stops)")
     parser.add_argument("--debug", action="store_true", help="log debug output and show tracebacks")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in SUBCOMMAND_MODULES:
@@ -37,7 +39,8 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.DEBUG if args.debug else logging.WARNING,
+    level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
+    logging.basicConfig(level=level,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         return int(args.func(args) or 0)
