@@ -54,6 +54,8 @@ class TrackOptions:
     record: bool = False
     realtime: bool = False
     attitude_feedback: str = "auto"
+    yaw_sign: int = 1  # -1 for a gimbal whose positive yaw speed turns the other way (seen on an RS 5)
+    pitch_sign: int = 1
     max_frames: int | None = None
     video: bool = True
     progress: bool = True
@@ -147,7 +149,8 @@ class TrackSession:
         estimate = self._track(frame, stamp)
         attitude = self._attitude_at(stamp)
         command = self.controller.update(estimate, attitude, time.monotonic())
-        self._streamer.set(command.yaw_dps, command.pitch_dps, stamp=stamp)
+        self._streamer.set(command.yaw_dps * self.options.yaw_sign,
+                           command.pitch_dps * self.options.pitch_sign, stamp=stamp)
         if estimate is not None and estimate.found and self.first_acquired_s is None:
             self.first_acquired_s = time.monotonic() - self._started
             if self.options.record:
@@ -194,7 +197,9 @@ class TrackSession:
         if not self.feedback:
             return (0.0, 0.0)
         sample = self.history.at(stamp)
-        return None if sample is None else (sample.yaw, sample.pitch)
+        if sample is None:
+            return None
+        return sample.yaw * self.options.yaw_sign, sample.pitch * self.options.pitch_sign
 
     def _write_frame(self, frame: Frame, stamp: float, estimate: TargetEstimate | None,
                      command: Any) -> None:

@@ -57,6 +57,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help=f"speed limit in deg/s (default: {ControlConfig().max_speed_dps:g}, at most 360)")
     control.add_argument("--attitude-feedback", choices=FEEDBACK_MODES, default="auto",
                          help="use the gimbal attitude (camera on the gimbal): auto = for live sources only")
+    control.add_argument("--invert-yaw", action="store_true",
+                         help="this gimbal turns the other way for positive yaw (check on hardware)")
+    control.add_argument("--invert-pitch", action="store_true",
+                         help="this gimbal turns the other way for positive pitch")
     run = parser.add_argument_group("run")
     run.add_argument("--realtime", action="store_true", help="play files at their own frame rate")
     run.add_argument("--fps", type=float, help="frame rate of an image folder (default: 30)")
@@ -88,6 +92,7 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         pick=args.pick or ("largest" if detect == "motion" else "central"), tracker=args.tracker, model_dir=args.model_dir, controller=args.controller,
         hfov_deg=args.hfov, rate_hz=args.rate, max_speed_dps=args.max_speed, record=args.record,
         realtime=args.realtime, attitude_feedback=args.attitude_feedback,
+        yaw_sign=-1 if args.invert_yaw else 1, pitch_sign=-1 if args.invert_pitch else 1,
         max_frames=args.max_frames, video=not args.no_video, progress=not args.quiet)
 
 

@@ -100,6 +100,19 @@ def test_commands_point_towards_the_subject(tmp_path: Path, corner: tuple[int, i
     assert not (tmp_path / "out" / "annotated.avi").exists()
 
 
+def test_inverted_axes_flip_the_rates_on_the_bus(tmp_path: Path) -> None:
+    """--invert-yaw/--invert-pitch for gimbals whose axes turn the other way (FIELD_NOTES)."""
+    def position(i: int) -> tuple[int, int]:
+        return 230 + i % 3, 170  # right of and below the centre: normally yaw +, pitch -
+
+    clip = make_clip(tmp_path / "clip.avi", 30, position)
+    assert run_track(clip, tmp_path / "out", "--roi", roi_at(position), "--no-video",
+                     "--invert-yaw", "--invert-pitch") == 0
+    moving = [c for c in speed_commands(decoded(tmp_path / "out" / "can.log")) if not c.zero]
+    assert len(moving) > 5
+    assert all(c.yaw < 0 and c.pitch > 0 for c in moving)
+
+
 def test_rates_ramp_to_zero_when_the_subject_leaves(tmp_path: Path) -> None:
     width = SIZE[0]
 
