@@ -20,7 +20,7 @@ from gimbal.errors import GimbalError
 from gimbal.messages import ParameterPush
 from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
 from pipelines.control import AttitudeHistory, CameraModel, ControlConfig, make_controller
-from pipelines.outputs.annotated_video import AnnotatedVideoWriter
+from pipelines.outputs.annotated_video import BackgroundVideoWriter
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.plot import write_timeseries_png
 from pipelines.outputs.summary import write_summary
@@ -122,10 +122,10 @@ class TrackSession:
         self.paths = {"telemetry": out / "telemetry.jsonl", "can_log": out / "can.log",
                       "summary": out / "summary.json", "plot": out / "plot.png"}
         self.telemetry = TelemetryWriter(self.paths["telemetry"])
-        self.video: AnnotatedVideoWriter | None = None
+        self.video: BackgroundVideoWriter | None = None
         if options.video:
             self.paths["video"] = out / "annotated.avi"
-            self.video = AnnotatedVideoWriter(self.paths["video"], source.size, source.fps or 30.0)
+            self.video = BackgroundVideoWriter(self.paths["video"], source.size, source.fps or 30.0)
 
     # -- the run -------------------------------------------------------------------------
     def start(self) -> None:

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import os
+import queue
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 from types import TracebackType
@@ -84,6 +86,61 @@ class AnnotatedVideoWriter:
         self._writer.release()
 
     def __enter__(self) -> AnnotatedVideoWriter:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()
+
+
+class BackgroundVideoWriter:
+    """An ``AnnotatedVideoWriter`` fed through a bounded queue and drained by its own thread, so
+    drawing and encoding (OpenCV releases the GIL) overlap the tracking loop. ``write`` blocks
+    when ``queue_size`` frames are waiting, so no frame is dropped; a failure in the worker is
+    raised by the next ``write`` or by ``close``."""
+
+    def __init__(self, path: str | os.PathLike[str], size: tuple[int, int], fps: float,
+                 queue_size: int = 32) -> None:
+        self._writer = AnnotatedVideoWriter(path, size, fps)
+        self.path = self._writer.path
+        self._queue: queue.Queue[tuple | None] = queue.Queue(maxsize=queue_size)
+        self._error: BaseException | None = None
+        self._reported = False
+        self._thread = threading.Thread(target=self._drain, name="annotated-video", daemon=True)
+        self._thread.start()
+
+    @property
+    def frames(self) -> int:
+        return self._writer.frames
+
+    def write(self, image: np.ndarray, estimate: TargetEstimate | None = None,
+              rates_dps: tuple[float, float] | None = None, lines: Sequence[str] = ()) -> None:
+        self._raise_error()
+        self._queue.put((image, estimate, rates_dps, tuple(lines)))
+
+    def close(self) -> None:
+        """Write what is queued, then finalise the file."""
+        if self._thread.is_alive():
+            self._queue.put(None)
+            self._thread.join()
+        self._writer.close()
+        self._raise_error()
+
+    def _drain(self) -> None:
+        while (item := self._queue.get()) is not None:
+            if self._error is None:
+                try:
+                    self._writer.write(*item)
+                except BaseException as exc:  # kept for the caller's thread
+                    self._error = exc
+
+    def _raise_error(self) -> None:
+        """Raise the worker's failure, once; the worker keeps draining (and dropping) after it."""
+        if self._error is not None and not self._reported:
+            self._reported = True
+            raise self._error
+
+    def __enter__(self) -> BackgroundVideoWriter:
         return self
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,

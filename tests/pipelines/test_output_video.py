@@ -8,7 +8,8 @@ import cv2
 import numpy as np
 import pytest
 
-from pipelines.outputs.annotated_video import STATE_COLOURS, AnnotatedVideoWriter, annotate
+from pipelines.outputs.annotated_video import (STATE_COLOURS, AnnotatedVideoWriter,
+                                               BackgroundVideoWriter, annotate)
 from pipelines.sources import open_source
 from tracker.estimate import TargetEstimate, TrackState
 
@@ -66,3 +67,26 @@ def test_avi_stays_readable_when_the_process_dies(tmp_path: Path, run_and_crash:
     while capture.read()[0]:
         count += 1
     assert count >= 50  # all but what was still in FFmpeg's write buffer
+
+
+def test_background_writer_keeps_every_frame_in_order(tmp_path):
+    path = tmp_path / "bg.avi"
+    with BackgroundVideoWriter(path, (64, 48), 10.0, queue_size=2) as writer:
+        for i in range(25):
+            writer.write(np.full((48, 64, 3), i * 10, np.uint8))
+    assert writer.frames == 25
+    capture = cv2.VideoCapture(str(path))
+    means = []
+    while (frame := capture.read())[0]:
+        means.append(float(frame[1][40:, 50:].mean()))  # a corner the annotation leaves alone
+    capture.release()
+    assert len(means) == 25
+    assert all(b > a for a, b in zip(means, means[1:]))
+
+
+def test_background_writer_reports_a_worker_failure_once(tmp_path):
+    writer = BackgroundVideoWriter(tmp_path / "bad.avi", (64, 48), 10.0)
+    writer.write(np.zeros((10, 10, 3), np.uint8))  # wrong size: fails in the worker thread
+    with pytest.raises(ValueError, match="frame is 10x10"):
+        writer.close()  # drains the queue, then reports what failed
+    writer.close()  # already reported: quiet
