@@ -52,7 +52,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     control.add_argument("--hfov", type=float, metavar="DEG",
                          help="camera horizontal field of view (default: 24 mm lens on full frame, 73.7)")
     control.add_argument("--rate", type=float, default=25.0, metavar="HZ",
-                         help="speed command rate (default: 25; one command lasts 0.5 s)")
+                         help="keep-alive rate of the speed command (default: 25; one command lasts 0.5 s); "
+                         "a new setpoint goes out at once, but never more than twice this often")
     control.add_argument("--max-speed", type=float, metavar="DEG_S",
                          help=f"speed limit in deg/s (default: {ControlConfig().max_speed_dps:g}, at most 360)")
     control.add_argument("--attitude-feedback", choices=FEEDBACK_MODES, default="auto",
