@@ -3,11 +3,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
+from collections.abc import Callable
 
 import cv2
 
 from pipelines.cli.common import CliError
+from pipelines.progress import ProgressReporter
 from tracker.datasets import load_sequence
 from tracker.evaluation import SequenceResult, run_sequence, summarize
 from tracker.registry import available_trackers, make_tracker
@@ -53,11 +54,16 @@ def _load(path: str):
     return sequence
 
 
-def _progress(name: str):
+def _progress(name: str) -> Callable[[int, int], None]:
+    """A progress callback for one sequence, drawn by the shared ProgressReporter on stderr."""
+    reporter: ProgressReporter | None = None
+
     def report(done: int, total: int) -> None:
-        if done % 50 == 0 or done == total:
-            end = "\n" if done == total else ""
-            print(f"\r{name}: {done}/{total} frames", end=end, file=sys.stderr, flush=True)
+        nonlocal reporter
+        reporter = reporter or ProgressReporter(total)
+        reporter.update(done, name, force=done == total)
+        if done == total:
+            reporter.close()
     return report
 
 
