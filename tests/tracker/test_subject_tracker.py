@@ -34,13 +34,16 @@ def test_default_follows_a_moving_target():
 
 def test_velocity_is_in_pixels_per_second():
     seq = render_sequence(frames=40, speed=3.0, seed=5)
-    vx, _ = _track("default", seq)[-1].velocity
-    assert vx == pytest.approx(3.0 * FPS, rel=0.35)
+    # One frame's velocity follows CSRT's per-frame box jitter (up to ~2x either way); the units
+    # show in its mean over the last half second.
+    vx = np.mean([e.velocity[0] for e in _track("default", seq)[-15:]])
+    assert vx == pytest.approx(3.0 * FPS, rel=0.2)
 
 
+@pytest.mark.parametrize("seed", range(5))
 @pytest.mark.parametrize("scale_change", [1.6, 0.7])
-def test_default_follows_scale_change(scale_change):
-    seq = render_sequence(frames=60, scale_change=scale_change, seed=2)
+def test_default_follows_scale_change(scale_change, seed):
+    seq = render_sequence(frames=60, scale_change=scale_change, seed=seed)
     last = _track("default", seq)[-1]
     assert last.box[2] == pytest.approx(seq.boxes[-1][2], rel=0.25)
 
