@@ -2,10 +2,14 @@
 from __future__ import annotations
 
 import os
+import uuid
+from collections.abc import Iterator
 from pathlib import Path
 
+import can
 import pytest
 
+from tests.gimbal.scripted_peer import ScriptedPeer
 from tracker.data_paths import DATA_ENV, shared_data_dir
 
 
@@ -19,3 +23,18 @@ def shared_data() -> Path:
     if os.environ.get("CI"):
         pytest.fail(message)
     pytest.skip(message)
+
+
+@pytest.fixture
+def channel() -> str:
+    """A python-can virtual channel of the test's own."""
+    return f"gimbaltrack-test-{uuid.uuid4().hex}"
+
+
+@pytest.fixture
+def peer(channel: str) -> Iterator[ScriptedPeer]:
+    """A scripted gimbal on ``channel``: it answers what the test tells it to."""
+    bus = can.Bus(interface="virtual", channel=channel)
+    with ScriptedPeer(bus) as scripted:
+        yield scripted
+    bus.shutdown()

@@ -8,37 +8,19 @@ import random
 import signal
 import subprocess
 import sys
-import uuid
-from collections.abc import Iterator
 from pathlib import Path
 
 import can
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "gimbal"))
-from scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages  # noqa: E402
-
-from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply  # noqa: E402
-from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl  # noqa: E402
-from gimbal.messages.settings import (AngleLimitsReply, GetAngleLimits,  # noqa: E402
-                                      SetAngleLimits)
-from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv  # noqa: E402
-from pipelines.cli import main  # noqa: E402
+from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
+from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl
+from gimbal.messages.settings import AngleLimitsReply, GetAngleLimits, SetAngleLimits
+from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv
+from pipelines.cli import main
+from tests.gimbal.scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages
 
 DOC_EXAMPLE = "AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE"
-
-
-@pytest.fixture
-def channel() -> str:
-    return f"cli-test-{uuid.uuid4().hex}"
-
-
-@pytest.fixture
-def peer(channel: str) -> Iterator[ScriptedPeer]:
-    bus = can.Bus(interface="virtual", channel=channel)
-    with ScriptedPeer(bus) as scripted:
-        yield scripted
-    bus.shutdown()
 
 
 def gimbal(channel: str, *args: str) -> int:

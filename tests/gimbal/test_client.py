@@ -5,46 +5,66 @@ import logging
 import signal
 import threading
 import time
-import uuid
 from collections.abc import Callable, Iterator
 from typing import Any
 
 import can
 import pytest
-from scripted_peer import RELEASE, ZERO, FlakyBus, ScriptedPeer, poll, speed_messages
 
 from gimbal.client import Angles, GimbalClient, exit_on_signals
 from gimbal.errors import BusError, GimbalTimeoutError, RangeError, ReturnCodeError
 from gimbal.messages import Message
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
-from gimbal.messages.external import (DialPush, FocusCalibration, FocusCalibrationReply,
-                                      FocusPositionControl, FocusPositionQuery, FocusPositionReply,
-                                      JoystickPush)
+from gimbal.messages.external import (
+    DialPush,
+    FocusCalibration,
+    FocusCalibrationReply,
+    FocusPositionControl,
+    FocusPositionQuery,
+    FocusPositionReply,
+    JoystickPush,
+)
 from gimbal.messages.motion import AnglesReply, GetAngles, PositionControl, SpeedControl
-from gimbal.messages.settings import (ActiveTrack, AngleLimitsReply, GetAngleLimits,
-                                      GetMotorStiffness, MotorStiffnessReply, RecenterSelfie,
-                                      SetAngleLimits, SetFollowMode, SetMotorStiffness, SetWorkMode)
-from gimbal.messages.telemetry import (ParameterPush, PushControl, VersionPush, VersionQuery,
-                                       VersionReply)
-from gimbal.messages.tlv_params import (AutoCalibration, CalibrationStatusPush, GetUserParams,
-                                        SetUserParams, SetUserParamsReply, Tlv, UserParamsReply,
-                                        motors_off)
+from gimbal.messages.settings import (
+    ActiveTrack,
+    AngleLimitsReply,
+    GetAngleLimits,
+    GetMotorStiffness,
+    MotorStiffnessReply,
+    RecenterSelfie,
+    SetAngleLimits,
+    SetFollowMode,
+    SetMotorStiffness,
+    SetWorkMode,
+)
+from gimbal.messages.telemetry import (
+    ParameterPush,
+    PushControl,
+    VersionPush,
+    VersionQuery,
+    VersionReply,
+)
+from gimbal.messages.tlv_params import (
+    AutoCalibration,
+    CalibrationStatusPush,
+    GetUserParams,
+    SetUserParams,
+    SetUserParamsReply,
+    Tlv,
+    UserParamsReply,
+    motors_off,
+)
 from gimbal.packet import encode_packet
+from tests.gimbal.scripted_peer import (
+    RELEASE,
+    ZERO,
+    FlakyBus,
+    ScriptedPeer,
+    poll,
+    speed_messages,
+)
 
 DOC_EXAMPLE = bytes.fromhex("AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE")
-
-
-@pytest.fixture
-def channel() -> str:
-    return f"gimbal-test-{uuid.uuid4().hex}"
-
-
-@pytest.fixture
-def peer(channel: str) -> Iterator[ScriptedPeer]:
-    bus = can.Bus(interface="virtual", channel=channel)
-    with ScriptedPeer(bus) as scripted:
-        yield scripted
-    bus.shutdown()
 
 
 @pytest.fixture

@@ -2,17 +2,22 @@
 from __future__ import annotations
 
 import time
-import uuid
 from collections.abc import Iterator
 
-import can
 import pytest
-from scripted_peer import RELEASE, ZERO, FlakyBus, ScriptedPeer, poll, speed_messages
 
 from gimbal.client import GimbalClient
 from gimbal.errors import BusError, GimbalError, RangeError
 from gimbal.keepalive import SpeedStreamer
 from gimbal.messages.motion import SpeedControl
+from tests.gimbal.scripted_peer import (
+    RELEASE,
+    ZERO,
+    FlakyBus,
+    ScriptedPeer,
+    poll,
+    speed_messages,
+)
 
 
 class FakeClock:
@@ -24,17 +29,10 @@ class FakeClock:
 
 
 @pytest.fixture
-def channel() -> str:
-    return f"keepalive-test-{uuid.uuid4().hex}"
-
-
-@pytest.fixture
-def peer(channel: str) -> Iterator[ScriptedPeer]:
-    bus = can.Bus(interface="virtual", channel=channel)
-    with ScriptedPeer(bus) as scripted:
-        scripted.answer(SpeedControl)
-        yield scripted
-    bus.shutdown()
+def peer(peer: ScriptedPeer) -> ScriptedPeer:
+    """The shared scripted peer, answering speed commands."""
+    peer.answer(SpeedControl)
+    return peer
 
 
 @pytest.fixture

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import signal
-import subprocess
 import time
 from pathlib import Path
 
@@ -15,8 +14,19 @@ import gimbal.sim
 import pipelines.cli.bus
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
-from tests.track.helpers import (DEMO, DEMO_ROI, assert_stopped_at_end, cli_command, decoded, free_udp_port,
-                                 run_track, speed_commands, start, subprocess_env, track_command)
+from tests.track.helpers import (
+    DEMO,
+    DEMO_ROI,
+    assert_stopped_at_end,
+    cli_command,
+    decoded,
+    free_udp_port,
+    run_track,
+    speed_commands,
+    start,
+    subprocess_env,
+    track_command,
+)
 
 GROUP = "239.74.163.9"
 
