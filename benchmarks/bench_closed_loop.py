@@ -3,15 +3,33 @@ with 0 and 100 ms added latency, all measured in this run (real time, simulated 
 detections so the figures isolate the control loop).
 
     .venv/bin/python benchmarks/bench_closed_loop.py [SEQ_DIR ...]
+    .venv/bin/python benchmarks/bench_closed_loop.py --bounds [SEQ_DIR ...]
+
+``--bounds`` prints, instead, two lower bounds on the RMS centring error of ANY controller
+(offline, no simulator), per latency:
+- information: the pointing at frame k can only depend on frames processed before it, i.e.
+  frames <= k - m (m = 1 at 0 ms, 4 at 100 ms with 30 fps and ~4 ms processing); so its error is
+  at least the error of predicting frame k from them. Shown: the best of standard predictors
+  (hold the last direction, constant-velocity Kalman at several noise levels), without any
+  acceleration limit. Not a proof over all predictors, the best of the usual ones.
+- acceleration: the best error with the WHOLE future known, at the simulator's 720 deg/s^2 per
+  axis, starting at rest and not moving before the first frame is processed (bounded least
+  squares over the axes' accelerations; scipy, which filterpy already requires).
 """
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
-import cv2
+import math
 
+import cv2
+import numpy as np
+
+from gimbal.sim import SimConfig
 from pipelines.closed_loop import LoopSettings, run_closed_loop
+from pipelines.control.direction import DirectionFilter
+from pipelines.virtual_camera import VirtualCamera
 from tracker.data_paths import shared_sequences
 from tracker.datasets import load_sequence
 
@@ -30,7 +48,60 @@ def wide_sequences() -> list[Path]:
     return found
 
 
+def _truth_angles(path: Path) -> tuple[np.ndarray, float]:
+    """World (yaw, pitch) of the subject's centre per frame, and degrees -> diagonal fraction."""
+    seq = load_sequence(path)
+    first = cv2.imread(str(seq.frame_paths[0]))
+    vc = VirtualCamera((first.shape[1], first.shape[0]))
+    angles = np.array([vc.source.pixel_to_angles(x + w / 2, y + h / 2) for x, y, w, h in seq.groundtruth])
+    return angles, math.radians(1.0) * vc.camera.focal_px / vc.camera.diagonal_px
+
+
+def _prediction_rms(angles: np.ndarray, ahead: int, predictor: str, accel_std: float, fps: float) -> float:
+    """RMS error (deg) of predicting frame k from frames <= k - ahead (before any: the start, 0)."""
+    kf, errs, state = DirectionFilter(accel_std_dps2=accel_std), [], None
+    for k in range(len(angles)):
+        if k - ahead >= 0:
+            state = kf.update(tuple(angles[k - ahead]), (k - ahead) / fps)
+        guess = (0.0, 0.0) if state is None else (
+            (state.yaw, state.pitch) if predictor == "hold" else state.at(k / fps))
+        errs.append(math.hypot(*(np.asarray(guess) - angles[k])))
+    return float(np.sqrt(np.mean(np.square(errs))))
+
+
+def _accel_bound(angles: np.ndarray, start_s: float, accel: float, fps: float, sub: int = 4) -> float:
+    """RMS angle error (deg) of the best trajectory from rest with |accel| <= accel per
+    axis, not moving before ``start_s``, knowing the whole future."""
+    from scipy.optimize import lsq_linear
+    n, h = len(angles), 1.0 / fps / sub
+    a = np.zeros((n, n * sub))
+    for k in range(n):
+        j = np.arange(k * sub)
+        a[k, j] = h * (k / fps - (j + 0.5) * h)
+    a[:, : int(round(start_s / h))] = 0.0
+    err = [a @ lsq_linear(a, angles[:, i], bounds=(-accel, accel)).x - angles[:, i] for i in (0, 1)]
+    return float(np.sqrt(np.mean(np.square(err[0]) + np.square(err[1]))))
+
+
+def bounds(sequences: list[Path], fps: float = 30.0, processing_s: float = 0.004) -> None:
+    accel = SimConfig().accel_dps2
+    for path in sequences:
+        angles, to_diag = _truth_angles(path)
+        for latency in LATENCIES_MS:
+            ahead = math.floor((latency / 1000 + processing_s) * fps) + 1
+            preds = {f"{p} (accel std {s:g})": _prediction_rms(angles, ahead, p, s, fps) * to_diag
+                     for p in ("hold", "cv") for s in (30.0, 100.0, 300.0, 1000.0)}
+            best = min(preds, key=preds.get)
+            acc = _accel_bound(angles, latency / 1000 + processing_s, accel, fps) * to_diag
+            print(f"{path.name:<14}{latency:>6} ms  information bound (frames <= k-{ahead}): "
+                  f"{preds[best]:.4f} [{best}]  acceleration bound ({accel:g} deg/s^2, future known): {acc:.4f}")
+
+
 def main(argv: list[str]) -> int:
+    if argv[:1] == ["--bounds"]:
+        sequences = [Path(a) for a in argv[1:]] or wide_sequences()
+        bounds(sequences)
+        return 0
     sequences = [Path(a) for a in argv] or wide_sequences()
     if not sequences:
         print("no 1280x720 sequence found (set GIMBALTRACK_DATA)")
