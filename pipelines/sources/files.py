@@ -1,7 +1,9 @@
 """Recorded sources: a video file or a folder of images, read as fast as pulled or paced in real time."""
 from __future__ import annotations
 
+import queue
 import re
+import threading
 import time
 from abc import abstractmethod
 from collections.abc import Callable
@@ -49,8 +51,15 @@ class Pacer:
         return now
 
 
+_END = object()  # the decoder thread's end-of-file marker
+
+
 class FileSource(FrameSource):
-    """A recorded sequence: frames are decoded when pulled, so none are ever dropped."""
+    """A recorded sequence: nothing is ever dropped. A decoder thread reads up to ``PREFETCH``
+    frames ahead (OpenCV releases the GIL while decoding), so decoding overlaps the consumer's
+    work on another core; a decode error reaches ``read`` in order."""
+
+    PREFETCH = 8
 
     def __init__(self, description: str, first: np.ndarray, fps: float | None,
                  frame_count: int | None, pacer: Pacer) -> None:
@@ -60,27 +69,63 @@ class FileSource(FrameSource):
         self._pacer = pacer
         self._index = 0
         self._closed = False
+        self._ended = False
+        self._ahead: queue.Queue[object] = queue.Queue(maxsize=self.PREFETCH)
+        self._stop = threading.Event()
+        self._decoder = threading.Thread(target=self._decode_ahead, name="frame-decoder", daemon=True)
+        self._decoder.start()
 
     def read(self) -> Frame | None:
-        if self._closed:
+        if self._closed or self._ended:
             return None
         if self._pending is not None:
             image, self._pending = self._pending, None
         else:
-            image = self._load(self._index)
-            if image is None:
+            item = self._ahead.get()
+            if isinstance(item, SourceError):
+                self._ended = True
+                raise item
+            if item is _END:
+                self._ended = True
                 return None
+            image = item
         frame = Frame(image, self._pacer.stamp(self._index), self._index)
         self._index += 1
         return frame
 
     def close(self) -> None:
+        """Stop the decoder thread (subclasses release their reader after this)."""
         self._closed = True
         self._pending = None
+        self._stop.set()
+        self._decoder.join()
+
+    def _decode_ahead(self) -> None:
+        index = 1
+        while not self._stop.is_set():
+            try:
+                image = self._load(index)
+            except SourceError as exc:
+                self._hand_over(exc)
+                return
+            if image is None:
+                self._hand_over(_END)
+                return
+            self._hand_over(image)
+            index += 1
+
+    def _hand_over(self, item: object) -> None:
+        while not self._stop.is_set():
+            try:
+                self._ahead.put(item, timeout=0.05)
+                return
+            except queue.Full:
+                continue
 
     @abstractmethod
     def _load(self, index: int) -> np.ndarray | None:
-        """Image number ``index`` (never 0: that one was read at open), or ``None`` at the end."""
+        """Image number ``index`` (never 0: that one was read at open), or ``None`` at the end;
+        called from the decoder thread only."""
 
 
 class VideoFileSource(FileSource):

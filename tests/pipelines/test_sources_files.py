@@ -118,3 +118,14 @@ def test_unreadable_image_in_folder(tmp_path: Path) -> None:
     (tmp_path / "0001.jpg").write_bytes(b"not a jpeg")
     with pytest.raises(SourceError, match="cannot read image"):
         open_source(str(tmp_path))
+
+
+def test_decoding_ahead_keeps_order_and_stops_on_close(small_video: Path) -> None:
+    source = open_source(str(small_video))
+    first = [source.read() for _ in range(3)]
+    assert [f.index for f in first] == [0, 1, 2]
+    decoder = source._decoder
+    assert decoder.is_alive()  # frames are waiting in the queue for the consumer
+    source.close()
+    assert not decoder.is_alive()
+    assert source.read() is None
