@@ -25,6 +25,8 @@ class TrackerSettings:
     adapt_confidence: float = 0.6  # the adaptive template learns only above this
     adapt_rate: float = 0.05
     lost_after_frames: int = 15  # consecutive low-confidence frames before declaring LOST
+    refine_reach: float = 0.1  # a confident box's centre is re-matched within this many box sizes ...
+    refine_blend: float = 0.5  # ... and moved this far towards the match
     search_reach: float = 1.0  # local search radius in box sizes, growing while searching
     max_reach: float = 4.0
 
@@ -86,12 +88,23 @@ class SubjectTracker:
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
     def _accept(self, frame: np.ndarray, box: Box, confidence: float, timestamp: float) -> TargetEstimate:
+        s = self.settings
         self._misses = 0
         self._size = (box[2], box[3])
+        if confidence >= s.adapt_confidence:
+            self._appearance.adapt(frame, box, s.adapt_rate)
+        if s.refine_blend > 0:
+            box = self._refine(frame, box)
         self._kalman.correct(box, confidence)
-        if confidence >= self.settings.adapt_confidence:
-            self._appearance.adapt(frame, box, self.settings.adapt_rate)
         return self._estimate(confidence, TrackState.TRACKING, timestamp)
+
+    def _refine(self, frame: np.ndarray, box: Box) -> Box:
+        """The box moved part-way towards the best template match near it (same size)."""
+        found = self._appearance.search(frame, box, (box[2], box[3]), self.settings.refine_reach)
+        if found.score <= 0.0:
+            return box
+        blend = self.settings.refine_blend
+        return (box[0] + blend * (found.box[0] - box[0]), box[1] + blend * (found.box[1] - box[1]), box[2], box[3])
 
     def _restart(self, frame: np.ndarray, box: Box, timestamp: float) -> None:
         self._backend = self._make_backend()
