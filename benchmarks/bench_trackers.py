@@ -1,7 +1,8 @@
 """Benchmark the project's trackers against OpenCV's own on every shared sequence, in one run.
 
 Prints per-sequence success AUC, mean AUC, mean precision@20px, median fps of the tracking
-step (one thread) and ratios against OpenCV's CSRT measured alongside. Usage:
+step (one thread; wall clock, and process CPU time, which the machine's other load affects less)
+and ratios against OpenCV's CSRT measured alongside. Usage:
 
     .venv/bin/python benchmarks/bench_trackers.py [--model-dir DIR] [--only NAME ...]
 """
@@ -76,14 +77,17 @@ def main(argv: list[str] | None = None) -> int:
 def _print_table(results: dict[str, list[SequenceResult]], names: list[str]) -> None:
     base = results[BASELINE]
     base_auc, base_fps = np.mean([r.auc for r in base]), np.median([r.fps for r in base])
+    base_cpu = np.median([r.cpu_fps for r in base])
     short = [n.split("_", 1)[-1][:8] for n in names]
-    print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps | AUC / CSRT | fps / CSRT |")
-    print("|---" * (len(names) + 6) + "|")
+    print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps "
+          "| AUC / CSRT | fps / CSRT | median CPU fps | CPU fps / CSRT |")
+    print("|---" * (len(names) + 8) + "|")
     for label, rows in results.items():
         auc, fps = np.mean([r.auc for r in rows]), np.median([r.fps for r in rows])
+        cpu = np.median([r.cpu_fps for r in rows])
         cells = " | ".join(f"{r.auc:.2f}" for r in rows)
         print(f"| {label} | {cells} | {auc:.3f} | {np.mean([r.prec20 for r in rows]):.3f} | {fps:.0f} "
-              f"| {auc / base_auc:.2f} | {fps / base_fps:.2f} |")
+              f"| {auc / base_auc:.2f} | {fps / base_fps:.2f} | {cpu:.0f} | {cpu / base_cpu:.2f} |")
 
 
 if __name__ == "__main__":
