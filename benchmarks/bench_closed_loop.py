@@ -18,10 +18,9 @@ detections so the figures isolate the control loop).
 """
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
-
-import math
 
 import cv2
 import numpy as np
@@ -78,8 +77,9 @@ def _accel_bound(angles: np.ndarray, start_s: float, accel: float, fps: float, s
     for k in range(n):
         j = np.arange(k * sub)
         a[k, j] = h * (k / fps - (j + 0.5) * h)
-    a[:, : int(round(start_s / h))] = 0.0
-    err = [a @ lsq_linear(a, angles[:, i], bounds=(-accel, accel)).x - angles[:, i] for i in (0, 1)]
+    a[:, : round(start_s / h)] = 0.0
+    err = [a @ lsq_linear(a, angles[:, i], bounds=(-accel, accel), method="bvls").x - angles[:, i]
+           for i in (0, 1)]
     return float(np.sqrt(np.mean(np.square(err[0]) + np.square(err[1]))))
 
 
