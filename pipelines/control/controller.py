@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from pipelines.control.camera import CameraModel
-from pipelines.control.direction import Direction, DirectionFilter, compose, wrap_deg
+from pipelines.control.direction import Direction, DirectionFilter, PredictionTrust, compose, wrap_deg
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate
 from pipelines.control.pid import Pid
 from tracker.estimate import TargetEstimate, TrackState
@@ -22,7 +22,7 @@ class ControlConfig:
 
     max_speed_dps: float = 120.0
     max_accel_dps2: float = 600.0
-    kp: float = 8.0  # deg/s per deg of error
+    kp: float = 12.0  # deg/s per deg of error (small errors; large ones see brake_accel_dps2)
     ki: float = 1.0
     kd: float = 0.0
     integral_limit_dps: float = 30.0
@@ -32,8 +32,11 @@ class ControlConfig:
     max_prediction_s: float = 0.35  # cap on how far ahead the target is extrapolated
     hold_s: float = 0.1  # after a loss, keep following the prediction this long ...
     ramp_s: float = 0.2  # ... then ramp linearly to zero speed over this long
+    brake_accel_dps2: float = 300.0  # closing speed at most sqrt(2 * this * |error|): no overshoot
     measurement_std_deg: float = 0.15
     target_accel_std_dps2: float = 300.0
+    trust_memory_s: float = 1.0  # memory of the prediction scoring (PredictionTrust)
+    reversal_factor: float = 2.0  # scoring horizon += this * (time to reverse the target's speed)
 
     def __post_init__(self) -> None:
         if not 0.0 < self.max_speed_dps <= PROTOCOL_MAX_SPEED_DPS:
@@ -87,6 +90,12 @@ class RateController:
     is extrapolated to when the new setpoint will act (``now + actuation_delay_s``); the gimbal's
     pointing at that time is predicted from the attitude at frame time plus the setpoints already
     sent (a Smith predictor), so pipeline latency does not destabilise the loop.
+    The extrapolation and the feed-forward are scaled by a trust (:class:`PredictionTrust`):
+    the share of the predicted motion that has been coming true over the time the loop needs
+    to act and to reverse the target's speed at the acceleration limit. Smooth motion keeps it
+    near 1; a subject whose speed jumps (throws, catches, bounces) drives it down, so the gimbal
+    does not commit to speeds it cannot shed in time (the overshoot that loses a juggled ball).
+    Large errors close at the speed from which the gimbal can still stop (``brake_accel_dps2``).
     Without detections it follows the prediction for ``hold_s``, then ramps to zero over ``ramp_s``.
     """
 
@@ -103,6 +112,7 @@ class RateController:
     def reset(self) -> None:
         c = self.config
         self._filter = DirectionFilter(c.measurement_std_deg, c.target_accel_std_dps2)
+        self._trust = PredictionTrust(c.trust_memory_s)
         self._pid_yaw, self._pid_pitch = self._pid(), self._pid()
         self._direction: Direction | None = None
         self._attitude: tuple[float, float, float] | None = None  # yaw, pitch, time
@@ -151,10 +161,14 @@ class RateController:
         if measured:
             if now - self._last_good > c.stop_within_s:  # a new acquisition starts afresh
                 self._filter.reset()
+                self._trust.reset()
                 self._pid_yaw.reset(self._last.yaw_dps)
                 self._pid_pitch.reset(self._last.pitch_dps)
             world = compose(self._pointing(frame_t), self.camera.pixel_to_angles(*estimate.center))
+            if attitude is not None:  # with a dead-reckoned pointing it would score our own model
+                self._trust.observe(world, frame_t, self._scoring_horizon(now, frame_t))
             self._direction = self._filter.update(world, frame_t)
+            self._trust.add(self._direction)
             self._last_good = now
             self._ramp_from = None
         elif estimate is not None and self._direction is not None:
@@ -174,16 +188,37 @@ class RateController:
                               estimate, now, limit_accel=False)
         return self._follow(dt, now, estimate, "track" if measured else "hold")
 
+    def _scoring_horizon(self, now: float, frame_t: float) -> float:
+        """How far ahead the prediction must hold: from the frame to when the setpoint acts,
+        plus the time the gimbal needs to reverse the target's speed at the acceleration limit
+        (a gimbal that matched a speed that then reverses is wrong for that long, and about as
+        long again while it recovers the angle lost: hence ``reversal_factor`` 2)."""
+        c, d = self.config, self._direction
+        speed = 0.0 if d is None else math.hypot(d.yaw_rate, d.pitch_rate)
+        return now + c.actuation_delay_s - frame_t + c.reversal_factor * 2.0 * speed / c.max_accel_dps2
+
     def _follow(self, dt: float, now: float, estimate: TargetEstimate | None, mode: str) -> RateCommand:
         c, d = self.config, self._direction
         t_act = min(now + c.actuation_delay_s, d.timestamp + c.max_prediction_s)
-        target = d.at(t_act)
+        w = self._trust.weight  # use the prediction only as far as it has been coming true
+        ahead = d.at(t_act)
+        target = wrap_deg(d.yaw + w * wrap_deg(ahead[0] - d.yaw)), d.pitch + w * (ahead[1] - d.pitch)
         gimbal = self._pointing(t_act)
         e_yaw, e_pitch = wrap_deg(target[0] - gimbal[0]), target[1] - gimbal[1]
         self._yaw_unwrapped += wrap_deg(gimbal[0] - self._yaw_unwrapped)
-        yaw = c.feedforward * d.yaw_rate + self._pid_yaw(e_yaw, dt, measurement=self._yaw_unwrapped)
-        pitch = c.feedforward * d.pitch_rate + self._pid_pitch(e_pitch, dt, measurement=gimbal[1])
+        ff = w * c.feedforward
+        yaw = ff * d.yaw_rate + self._pid_yaw(self._shaped(e_yaw), dt, measurement=self._yaw_unwrapped)
+        pitch = ff * d.pitch_rate + self._pid_pitch(self._shaped(e_pitch), dt, measurement=gimbal[1])
         return self._emit(yaw, pitch, mode, dt, estimate, now, (e_yaw, e_pitch))
+
+    def _shaped(self, error: float) -> float:
+        """The error the PID sees: unchanged while kp * |error| <= sqrt(2 * brake * |error|),
+        beyond that shrunk so the closing speed is the speed from which the gimbal can still
+        stop on the target at ``brake_accel_dps2`` (large steps close fast without overshoot)."""
+        c, e = self.config, abs(error)
+        if c.kp * c.kp * e <= 2.0 * c.brake_accel_dps2:
+            return error
+        return math.copysign(math.sqrt(2.0 * c.brake_accel_dps2 * e) / c.kp, error)
 
     def _emit(self, yaw: float, pitch: float, mode: str, dt: float, estimate: TargetEstimate | None,
               now: float, errors: tuple[float, float] = (0.0, 0.0), limit_accel: bool = True) -> RateCommand:

@@ -7,6 +7,7 @@ The gimbal is modelled as yaw-then-pitch (roll held level), so a target's world 
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,3 +124,48 @@ class DirectionFilter:
                 self._kf.update(np.array([yaw, measurement[1]]))
         x = self._kf.x
         return Direction(wrap_deg(float(x[0])), float(x[2]), float(x[1]), float(x[3]), self._t)
+
+
+class PredictionTrust:
+    """How much of the filter's extrapolation to use at the loop's own prediction horizon.
+
+    Every new measurement is compared with the filter as it stood ``horizon`` earlier: its
+    extrapolation predicted a displacement ``d`` (from its then direction), the target actually
+    moved ``m``. The trust is the least-squares gain of ``m`` on ``d`` over an exponential memory
+    of ``memory_s``, ``weight = E[m.d] / E[d.d]`` clipped to [0, 1]: the share of the predicted
+    motion that has been happening. Near 1 for smooth motion (pans, ramps, sines, ballistic
+    arcs), near 0 when contacts and reversals make the extrapolation no better than standing
+    still. It starts trusting (prior gain 1 worth ``prior_deg2``).
+    """
+
+    def __init__(self, memory_s: float = 1.0, prior_deg2: float = 0.01) -> None:
+        self.memory_s = memory_s
+        self.prior_deg2 = prior_deg2
+        self._history: deque[Direction] = deque(maxlen=64)
+        self.reset()
+
+    @property
+    def weight(self) -> float:
+        return min(1.0, max(0.0, self._cross / self._predicted))
+
+    def reset(self) -> None:
+        self._cross = self._predicted = self.prior_deg2
+        self._history.clear()
+        self._last_t: float | None = None
+
+    def observe(self, measurement: tuple[float, float], t: float, horizon: float) -> None:
+        """Score the prediction made ``horizon`` before ``t`` against ``measurement``."""
+        past = next((d for d in reversed(self._history) if d.timestamp <= t - horizon + 1e-6), None)
+        if past is None:
+            return
+        yaw, pitch = past.at(t)
+        predicted = (wrap_deg(yaw - past.yaw), pitch - past.pitch)
+        moved = (wrap_deg(measurement[0] - past.yaw), measurement[1] - past.pitch)
+        keep = math.exp(-max(t - (past.timestamp if self._last_t is None else self._last_t), 0.0)
+                        / self.memory_s)
+        self._cross = keep * self._cross + (1.0 - keep) * (moved[0] * predicted[0] + moved[1] * predicted[1])
+        self._predicted = keep * self._predicted + (1.0 - keep) * (predicted[0] ** 2 + predicted[1] ** 2)
+        self._last_t = t
+
+    def add(self, direction: Direction) -> None:
+        self._history.append(direction)

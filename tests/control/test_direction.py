@@ -3,7 +3,7 @@ import math
 import pytest
 from hypothesis import given, strategies as st
 
-from pipelines.control.direction import DirectionFilter, compose, relative, wrap_deg
+from pipelines.control.direction import DirectionFilter, PredictionTrust, compose, relative, wrap_deg
 
 angles = st.floats(-179.9, 179.9)
 pitches = st.floats(-80, 80)
@@ -55,3 +55,38 @@ def test_update_none_only_predicts():
     assert p.yaw_rate == pytest.approx(d.yaw_rate)
     assert kf._kf.P.trace() > before  # uncertainty grows, no measurement folded in
     assert d.at(d.timestamp + 0.5) == pytest.approx((p.yaw, p.pitch))
+
+
+def _zigzag(t):
+    """10 deg back and forth, reversing every 0.2 s."""
+    return abs((t * 5.0) % 2.0 - 1.0) * 10.0, 0.0
+
+
+def _trust_after(path, horizon=0.1, frames=90):
+    kf, trust = DirectionFilter(), PredictionTrust()
+    for i in range(frames):
+        t = i / 30
+        z = path(t)
+        trust.observe(z, t, horizon)
+        trust.add(kf.update(z, t))
+    return trust.weight
+
+
+def test_prediction_trust_is_high_for_smooth_motion_and_low_for_reversals():
+    assert PredictionTrust().weight == 1.0  # it starts trusting
+    assert _trust_after(lambda t: (30.0 * t, -5.0 + 6.0 * t)) > 0.95
+    assert _trust_after(lambda t: (15.0 * math.sin(math.pi * t), 0.0)) > 0.8
+    assert _trust_after(_zigzag) < 0.4  # over 0.1 s the extrapolation is wrong half the time
+
+
+def test_prediction_trust_reset_forgets():
+    trust = PredictionTrust()
+    kf = DirectionFilter()
+    for i in range(60):
+        t = i / 30
+        z = _zigzag(t)
+        trust.observe(z, t, 0.1)
+        trust.add(kf.update(z, t))
+    assert trust.weight < 0.5
+    trust.reset()
+    assert trust.weight == 1.0
