@@ -73,7 +73,6 @@ def run_scene(controller: Controller, subject: Subject, duration: float, *,
     rng = np.random.default_rng(seed)
     plant = Plant(tau, plant_delay)
     trace = Trace()
-    history: list[tuple[float, float, float]] = []  # attitude at each frame time
     pending: deque[tuple[float, TargetEstimate | None, tuple[float, float]]] = deque()
     n = int(duration / frame_dt)
     for i in range(n + int(latency / frame_dt) + 1):
