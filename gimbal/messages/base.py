@@ -44,6 +44,7 @@ class Message:
     NAME: ClassVar[str]
     FORMAT: ClassVar[str] = ""
     RANGES: ClassVar[Mapping[str, tuple[int, int]]] = {}
+    UNITS: ClassVar[Mapping[str, tuple[float, str]]] = {}  # field -> (one raw step, unit), for errors
     CHOICES: ClassVar[Mapping[str, frozenset[int]]] = {}
     REPLY: ClassVar[type[Message] | None] = None  # a command's reply; None: the document has none
     PARTIAL: ClassVar[bool] = False  # a shorter payload decodes with the missing fields as None
@@ -104,10 +105,18 @@ class Message:
             if value.__class__ is not int and (not isinstance(value, int) or isinstance(value, bool)):
                 raise RangeError(f"{self.NAME}.{name} must be an integer, not {value!r}")
             if not low <= value <= high:
-                raise RangeError(f"{self.NAME}.{name}={value} is outside {low}..{high}")
+                raise RangeError(f"{self.NAME}.{name}={value} is outside {low}..{high}"
+                                 + self._in_units(name, value, low, high))
             if allowed is not None and value not in allowed:
                 listed = ", ".join(f"0x{v:02X}" for v in sorted(allowed))
                 raise RangeError(f"{self.NAME}.{name}=0x{value:02X} is not one of {listed}")
+
+    def _in_units(self, name: str, value: int, low: int, high: int) -> str:
+        """`` (300°: -180..180°)`` for a field with a unit, else nothing."""
+        if name not in self.UNITS:
+            return ""
+        step, unit = self.UNITS[name]
+        return f" ({value * step:g}{unit}: allowed {low * step:g}..{high * step:g}{unit})"
 
     def fields(self) -> dict[str, Any]:
         """The fields as JSON-friendly values (bytes as hex)."""

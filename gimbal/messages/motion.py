@@ -11,6 +11,8 @@ YAW_ANGLE_RANGE = (-1800, 1800)
 ROLL_ANGLE_RANGE = (-300, 300)
 PITCH_ANGLE_RANGE = (-560, 1460)
 SPEED_RANGE = (-3600, 3600)  # the document gives 0..360 °/s as a magnitude; the sign is direction
+DECI_DEGREE = (0.1, "°")
+DECI_DEGREE_PER_S = (0.1, "°/s")
 
 POSITION_ABSOLUTE = 0x01
 POSITION_YAW_INVALID = 0x02
@@ -43,6 +45,7 @@ class PositionControl(Command):
     FORMAT: ClassVar[str] = "hhhBB"
     RANGES: ClassVar = {"yaw_angle": YAW_ANGLE_RANGE, "roll_angle": ROLL_ANGLE_RANGE,
                         "pitch_angle": PITCH_ANGLE_RANGE, "ctrl_byte": (0, 0x0F)}
+    UNITS: ClassVar = {"yaw_angle": DECI_DEGREE, "roll_angle": DECI_DEGREE, "pitch_angle": DECI_DEGREE}
     REPLY: ClassVar = PositionControlReply
     yaw_angle: int = 0
     roll_angle: int = 0
@@ -69,6 +72,8 @@ class SpeedControl(Command):
     NAME: ClassVar[str] = "speed_control"
     FORMAT: ClassVar[str] = "hhhB"
     RANGES: ClassVar = {"yaw_speed": SPEED_RANGE, "roll_speed": SPEED_RANGE, "pitch_speed": SPEED_RANGE}
+    UNITS: ClassVar = {"yaw_speed": DECI_DEGREE_PER_S, "roll_speed": DECI_DEGREE_PER_S,
+                       "pitch_speed": DECI_DEGREE_PER_S}
     CHOICES: ClassVar = {"ctrl_byte": frozenset({0x00, 0x08, 0x80, 0x88})}  # reserved bits are 0
     REPLY: ClassVar = SpeedControlReply
     yaw_speed: int = 0

@@ -436,3 +436,12 @@ def test_camera_status_reply_is_20_bytes() -> None:
     assert len(raw) == 20
     assert decode_message(decode_packet(raw), CameraStatusQuery).recording is True
     assert FocusCalibrationReply().result == 0
+
+
+def test_range_errors_speak_in_degrees_where_the_field_has_a_unit():
+    from gimbal.messages.motion import PositionControl, SpeedControl
+
+    with pytest.raises(RangeError, match=r"yaw_angle=3000 is outside -1800\.\.1800 \(300°: allowed -180\.\.180°\)"):
+        PositionControl(yaw_angle=3000).encode_payload()
+    with pytest.raises(RangeError, match=r"\(-400°/s: allowed -360\.\.360°/s\)"):
+        SpeedControl(pitch_speed=-4000).encode_payload()
