@@ -100,6 +100,8 @@ class SimulatedGimbal:
                 self._on_frame(frame)
 
     def _on_frame(self, frame: can.Message) -> None:
+        if frame.arbitration_id == self.config.tx_id and not frame.is_extended_id:
+            return  # our own frame handed back by an echoing bus (udp_multicast): not a fault
         with self._lock:
             if frame.arbitration_id != self.config.rx_id or frame.is_extended_id \
                     or frame.is_error_frame or frame.is_remote_frame:
