@@ -15,6 +15,8 @@ IMAGE_SUFFIXES = {".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp"}
 VIDEO_SUFFIXES = {".avi", ".mp4", ".mov", ".mkv", ".webm", ".m4v", ".mpg", ".mpeg"}
 GROUNDTRUTH_NAMES = ("groundtruth_rect.txt", "groundtruth.txt")
 FRAME_DIRS = ("img", "imgs", "color")
+#: Frame rate assumed for timestamps when a sequence does not tell its own (OTB sequences are 30 fps).
+ASSUMED_FPS = 30.0
 
 
 @dataclass(frozen=True)
@@ -92,10 +94,20 @@ def load_sequence(path: str | Path, groundtruth: str | Path | None = None) -> Se
     return Sequence(path.name, frame_paths=frames, groundtruth=truth)
 
 
+def _natural_key(path: Path) -> list[int | str]:
+    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", path.name)]
+
+
+def list_images(folder: Path) -> list[Path]:
+    """The image files directly in ``folder`` in natural name order (``2.jpg`` before ``10.jpg``)."""
+    return sorted((p for p in Path(folder).iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()),
+                  key=_natural_key)
+
+
 def _find_frames(folder: Path) -> tuple[Path, ...]:
     for candidate in [folder / d for d in FRAME_DIRS] + [folder]:
         if candidate.is_dir():
-            images = sorted(p for p in candidate.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+            images = list_images(candidate)
             if images:
                 return tuple(images)
     raise ValueError(f"no image frames in {folder} (looked in {', '.join(FRAME_DIRS)} and the folder itself)")

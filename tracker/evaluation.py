@@ -9,11 +9,9 @@ from typing import Protocol
 import numpy as np
 
 from tracker.boxes import Box
-from tracker.datasets import Sequence
+from tracker.datasets import ASSUMED_FPS, Sequence
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.metrics import precision_at, success_auc
-
-FRAME_RATE = 30.0  # timestamps given to the tracker for image sequences
 
 
 class Trackable(Protocol):
@@ -52,7 +50,7 @@ def run_sequence(tracker: Trackable, sequence: Sequence,
     elapsed = cpu = 0.0
     total = len(sequence)
     for index, frame in enumerate(sequence.frames()):
-        timestamp = index / FRAME_RATE
+        timestamp = index / ASSUMED_FPS
         if index == 0:
             tracker.init(frame, truth[0], timestamp)
             boxes.append(truth[0])

@@ -5,7 +5,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tracker.datasets import load_sequence, parse_groundtruth
+from tracker.datasets import list_images, load_sequence, parse_groundtruth
 
 
 def _write_frames(folder: Path, count: int, name: str = "{:04d}.jpg") -> None:
@@ -54,6 +54,16 @@ def test_image_folder_without_groundtruth(tmp_path):
     _write_frames(tmp_path, 4)
     seq = load_sequence(tmp_path)
     assert seq.groundtruth is None and len(seq) == 4
+
+
+def test_unpadded_frames_are_read_in_natural_order(tmp_path):
+    _write_frames(tmp_path / "img", 11, "{}.jpg")
+    (tmp_path / "img" / "notes.txt").write_text("not an image")
+    (tmp_path / "img" / "12.PNG").write_bytes((tmp_path / "img" / "1.jpg").read_bytes())
+    assert [p.name for p in list_images(tmp_path / "img")] == [f"{i}.jpg" for i in range(1, 12)] + ["12.PNG"]
+    seq = load_sequence(tmp_path)
+    assert [p.name for p in seq.frame_paths[:3]] == ["1.jpg", "2.jpg", "3.jpg"]
+    assert [int(f[0, 0, 0]) for f in list(seq.frames())[:3]] == [0, 20, 40]
 
 
 def test_more_boxes_than_frames_is_an_error(tmp_path):
