@@ -18,7 +18,7 @@ class TrackingBackend(Protocol):
     name: str
 
     def init(self, frame: np.ndarray, box: Box) -> None:
-        """Start on ``box`` in ``frame``."""
+        """Start on ``box`` in ``frame``, forgetting anything learnt before (called again to restart)."""
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
         """The new box (``None`` when the backend gives up) and its own score in 0..1."""

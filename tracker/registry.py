@@ -25,8 +25,7 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None) -> 
         name = DEFAULT_WITH_MODELS if model_dir is not None and _has_nanotrack(model_dir) else DEFAULT_BACKEND
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
-    make_backend(name, model_dir)  # fails now, not on init(), when files are missing
-    return SubjectTracker(name, lambda: make_backend(name, model_dir))
+    return SubjectTracker(name, make_backend(name, model_dir))  # missing model files fail here, not on init()
 
 
 def _has_nanotrack(model_dir: str | Path) -> bool:

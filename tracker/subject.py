@@ -1,7 +1,6 @@
 """SubjectTracker: a backend, a box Kalman filter, a confidence and re-acquisition."""
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,14 +40,13 @@ class SubjectTracker:
     after ``lost_after_frames`` misses it reports ``LOST`` and holds the last box.
     """
 
-    def __init__(self, name: str, make_backend: Callable[[], TrackingBackend],
+    def __init__(self, name: str, backend: TrackingBackend,
                  detector: Detector | None = None, settings: TrackerSettings | None = None) -> None:
         self.name = name
-        self._make_backend = make_backend
+        self._backend = backend
         self._detector = detector
         self.settings = settings or TrackerSettings()
         self._kalman = BoxKalman()
-        self._backend: TrackingBackend | None = None
         self._appearance: AppearanceModel | None = None
         self._size: tuple[float, float] = (0.0, 0.0)
         self._misses = 0
@@ -65,7 +63,7 @@ class SubjectTracker:
 
     def update(self, frame: np.ndarray, timestamp: float) -> TargetEstimate:
         """Follow the subject into ``frame`` captured at ``timestamp`` (seconds)."""
-        if self._backend is None or self._appearance is None:
+        if self._appearance is None:
             raise RuntimeError("SubjectTracker.update() before init()")
         self._frame_index += 1
         s = self.settings
@@ -107,8 +105,7 @@ class SubjectTracker:
         return (box[0] + blend * (found.box[0] - box[0]), box[1] + blend * (found.box[1] - box[1]), box[2], box[3])
 
     def _restart(self, frame: np.ndarray, box: Box, timestamp: float) -> None:
-        self._backend = self._make_backend()
-        self._backend.init(frame, box)
+        self._backend.init(frame, box)  # (re)starts the backend from scratch on this box
         self._kalman.reset(box, timestamp)
         self._size = (box[2], box[3])
         self._misses = 0
