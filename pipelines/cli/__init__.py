@@ -7,7 +7,7 @@ import logging
 import os
 import sys
 
-from pipelines.cli.common import CliError
+from pipelines.cli.common import EXIT_INTERRUPTED, CliError
 
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
 SUBCOMMAND_MODULES = [
@@ -51,7 +51,7 @@ def main(argv: list[str] | None = None) -> int:
         return exc.exit_code
     except KeyboardInterrupt:
         print(f"gimbaltrack {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader went away (e.g. `| head`): not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0

@@ -3,6 +3,9 @@ from __future__ import annotations
 
 import argparse
 
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
+EXIT_INTERRUPTED = 130
+
 
 class CliError(Exception):
     """A user-facing failure: printed as one line, exit code ``exit_code``."""

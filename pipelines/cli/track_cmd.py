@@ -11,14 +11,14 @@ from gimbal.client import GimbalClient, exit_on_signals
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from pipelines.acquire import PICKS, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
-from pipelines.cli.common import CliError, add_bus_options
+from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options
 from pipelines.control import ControlConfig, controller_names
+from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter, LoggingBus
 from pipelines.sources import FrameSource, SourceError, open_source
 from pipelines.track_session import FEEDBACK_MODES, TrackOptions, TrackSession
 from tracker import available_trackers
 
-EXIT_INTERRUPTED = 130
 DEFAULT_DETECTOR = "motion"
 
 
@@ -55,7 +55,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="keep-alive rate of the speed command (default: 25; one command lasts 0.5 s); "
                          "a new setpoint goes out at once, but never more than twice this often")
     control.add_argument("--max-speed", type=float, metavar="DEG_S",
-                         help=f"speed limit in deg/s (default: {ControlConfig().max_speed_dps:g}, at most 360)")
+                         help=f"speed limit in deg/s (default: {ControlConfig().max_speed_dps:g}, "
+                         f"at most {PROTOCOL_MAX_SPEED_DPS:g})")
     control.add_argument("--attitude-feedback", choices=FEEDBACK_MODES, default="auto",
                          help="use the gimbal attitude (camera on the gimbal): auto = for live sources only")
     control.add_argument("--invert-yaw", action="store_true",
@@ -83,8 +84,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError(str(exc)) from None
     if not args.rate > 0:
         raise CliError("--rate must be positive")
-    if args.max_speed is not None and not 0 < args.max_speed <= 360:
-        raise CliError("--max-speed takes 0 < DEG_S <= 360 (the protocol's limit)")
+    if args.max_speed is not None and not 0 < args.max_speed <= PROTOCOL_MAX_SPEED_DPS:
+        raise CliError(f"--max-speed takes 0 < DEG_S <= {PROTOCOL_MAX_SPEED_DPS:g} (the protocol's limit)")
     if args.max_frames is not None and args.max_frames < 1:
         raise CliError("--max-frames must be at least 1")
     detect = args.detect or (None if roi else DEFAULT_DETECTOR)
