@@ -8,7 +8,7 @@ from typing import Any
 
 import can
 
-from gimbal.sim import start_in_process
+from gimbal.sim import SimConfig, SimulatedGimbal, start_in_process
 from pipelines.cli.common import CliError
 
 SIM_INTERFACE = "sim"
@@ -28,23 +28,24 @@ def open_host_bus(args: argparse.Namespace) -> Iterator[can.BusABC]:
     """The host's bus for the subcommand; ``-i sim`` starts the simulated gimbal in-process.
     Failures to open become one-line ``CliError``s; the bus is shut down on exit."""
     if args.interface == SIM_INTERFACE:
-        with _simulated_gimbal() as bus:
+        with simulated_gimbal(args) as (bus, _):
             yield bus
         return
-    bus = _open(bus_options(args))
+    bus = open_can_bus(bus_options(args))
     try:
         yield bus
     finally:
         bus.shutdown()
 
 
-def _open(options: dict[str, Any]) -> can.BusABC:
+def open_can_bus(options: dict[str, Any]) -> can.BusABC:
+    """``can.Bus(**options)``; failures become one-line ``CliError``s."""
     try:
         config = can.util.load_config(config=dict(options))
     except can.CanInterfaceNotImplementedError as exc:
         if '"None"' in str(exc):  # python-can's words when no source names an interface
             raise CliError(NO_INTERFACE) from None
-        raise CliError(f"unknown CAN interface: {_one_line(exc)}") from None
+        raise CliError(f"cannot open the CAN bus: unknown CAN interface: {_one_line(exc)}") from None
     where = f"{config['interface']} channel {config.get('channel')}"
     try:
         return can.Bus(**options)
@@ -53,10 +54,12 @@ def _open(options: dict[str, Any]) -> can.BusABC:
 
 
 @contextmanager
-def _simulated_gimbal() -> Iterator[can.BusABC]:
-    host_bus, sim = start_in_process()
+def simulated_gimbal(args: argparse.Namespace) -> Iterator[tuple[can.BusABC, SimulatedGimbal]]:
+    """(host bus, simulated gimbal) for ``-i sim``: the simulator listens on --tx-id and answers
+    on --rx-id; both are stopped on exit."""
+    host_bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id))
     try:
-        yield host_bus
+        yield host_bus, sim
     finally:
         sim.stop()
         host_bus.shutdown()

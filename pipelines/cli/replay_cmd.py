@@ -21,7 +21,7 @@ from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
 from gimbal.messages import message_packet
 from gimbal.messages.motion import SPEED_TAKE_CONTROL, SpeedControl
 from gimbal.transport import CanTransport
-from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
+from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
 from pipelines.cli.decode_cmd import _close, _next_frame, _open_log
 from pipelines.cli.sim_cmd import status_line
@@ -175,13 +175,8 @@ def _target(args: argparse.Namespace) -> Iterator[tuple[can.BusABC | None, Any]]
         yield None, None
         return
     if args.interface == SIM_INTERFACE:
-        from gimbal.sim import SimConfig, start_in_process
-        bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id))
-        try:
-            yield bus, sim
-        finally:
-            sim.stop()
-            bus.shutdown()
+        with simulated_gimbal(args) as pair:
+            yield pair
         return
     with open_host_bus(args) as bus:
         yield bus, None

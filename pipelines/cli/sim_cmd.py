@@ -8,12 +8,12 @@ import signal
 import threading
 import time
 from types import FrameType
-from typing import Any
 
 import can
 
 from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
 from gimbal.sim.faults import DIRECTIONS
+from pipelines.cli.bus import SIM_INTERFACE, bus_options, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int
 
 
@@ -115,14 +115,9 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
 
 
 def open_bus(args: argparse.Namespace) -> can.BusABC:
-    if args.interface == "sim":
+    if args.interface == SIM_INTERFACE:
         raise CliError("'-i sim' is the in-process simulator; give 'sim' a real bus, e.g. -i udp_multicast")
-    kwargs: dict[str, Any] = {k: v for k, v in (("interface", args.interface), ("channel", args.channel),
-                                                 ("bitrate", args.bitrate)) if v is not None}
-    try:
-        return can.Bus(**kwargs)
-    except (can.CanError, OSError, ValueError, ImportError) as exc:
-        raise CliError(f"cannot open the CAN bus ({', '.join(f'{k}={v}' for k, v in kwargs.items())}): {exc}") from None
+    return open_can_bus(bus_options(args))
 
 
 def status_line(state: SimState, elapsed: float) -> str:
