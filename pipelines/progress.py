@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Callable
 from typing import TextIO
 
 
@@ -21,11 +22,14 @@ class ProgressReporter:
         self._start = time.monotonic()
         self._drawn = False
 
-    def update(self, done: int, status: str = "", force: bool = False) -> None:
+    def update(self, done: int, status: str | Callable[[], str] = "", force: bool = False) -> None:
+        """Redraw if due (or ``force``); a callable ``status`` is called only when the line is drawn."""
         now = time.monotonic()
         if not self.enabled or (not force and now - self._last < self.interval):
             return
         self._last = now
+        if callable(status):
+            status = status()
         fps = done / max(now - self._start, 1e-9)
         if self.total:
             share = min(done / self.total, 1.0)

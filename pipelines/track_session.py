@@ -116,8 +116,7 @@ class TrackSession:
         self._started = time.monotonic()
         self._last_summary = 0.0
         self._streamer = None
-        self._progress = ProgressReporter(source.frame_count if not source.is_live else None,
-                                          enabled=options.progress)
+        self._progress = ProgressReporter(source.frame_count, enabled=options.progress)
         out = options.out_dir
         self.paths = {"telemetry": out / "telemetry.jsonl", "can_log": out / "can.log",
                       "summary": out / "summary.json", "plot": out / "plot.png"}
@@ -159,8 +158,8 @@ class TrackSession:
         state = estimate.state.value if estimate is not None else "acquiring"
         self.states[state] += 1
         self._write_frame(frame, stamp, estimate, command)
-        self._progress.update(self.frames, f"{state:<9} yaw {command.yaw_dps:+6.1f} "
-                                           f"pitch {command.pitch_dps:+6.1f} deg/s")
+        self._progress.update(self.frames, lambda: f"{state:<9} yaw {command.yaw_dps:+6.1f} "
+                                                   f"pitch {command.pitch_dps:+6.1f} deg/s")
         if time.monotonic() - self._last_summary >= SUMMARY_EVERY_S:
             self.write_summary()
 
