@@ -39,23 +39,32 @@ class VirtualCamera:
         else:
             self.camera = CameraModel(*out_size, hfov_deg=hfov_deg)
         self._k_src = _intrinsics(self.source)
-        self._k_view = _intrinsics(self.camera)
+        self._k_view_inv = np.linalg.inv(_intrinsics(self.camera))
+        self._last: tuple[tuple[float, float], np.ndarray, np.ndarray] | None = None
 
-    def _view_to_source(self, yaw: float, pitch: float) -> np.ndarray:
-        """Homography from view pixels to source pixels for a gimbal at (yaw, pitch) degrees."""
-        r_cv = _TO_CV @ rotation_matrix(yaw, pitch) @ _TO_CV.T
-        return self._k_src @ r_cv @ np.linalg.inv(self._k_view)
+    def _homographies(self, yaw: float, pitch: float) -> tuple[np.ndarray, np.ndarray]:
+        """Homographies view -> source and source -> view for a gimbal at (yaw, pitch) degrees.
+
+        The last attitude's pair is kept, so rendering a frame and mapping its boxes at the same
+        attitude builds them once.
+        """
+        last = self._last
+        if last is None or last[0] != (yaw, pitch):
+            r_cv = _TO_CV @ rotation_matrix(yaw, pitch) @ _TO_CV.T
+            to_source = self._k_src @ r_cv @ self._k_view_inv
+            last = self._last = ((yaw, pitch), to_source, np.linalg.inv(to_source))
+        return last[1], last[2]
 
     def render(self, frame: np.ndarray, yaw: float, pitch: float) -> np.ndarray:
         """What the view sees (black where it looks past the recorded frame)."""
-        h = self._view_to_source(yaw, pitch)
+        h, _ = self._homographies(yaw, pitch)
         return cv2.warpPerspective(frame, h, (self.camera.width, self.camera.height),
                                    flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
                                    borderMode=cv2.BORDER_CONSTANT)
 
     def to_view(self, points: np.ndarray, yaw: float, pitch: float) -> np.ndarray:
         """Source pixels (N x 2) -> view pixels (N x 2); NaN for points behind the view."""
-        h = np.linalg.inv(self._view_to_source(yaw, pitch))
+        _, h = self._homographies(yaw, pitch)
         p = np.c_[np.asarray(points, float).reshape(-1, 2), np.ones(len(points))] @ h.T
         out = p[:, :2] / p[:, 2:3]
         out[p[:, 2] <= 0] = np.nan
