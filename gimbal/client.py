@@ -48,7 +48,7 @@ from gimbal.messages.telemetry import (DEVICE_ID_R_SDK, PUSH_DISABLE, PUSH_ENABL
                                        VersionPush, VersionQuery, VersionReply)
 from gimbal.messages.tlv_params import (AutoCalibration, GetUserParams, SetUserParams, Tlv,
                                         autotune)
-from gimbal.packet import REPLY_OPTIONAL, Packet
+from gimbal.packet import REPLY_OPTIONAL, Packet, encode_packet
 from gimbal.pushes import PushCallback, PushHub
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport
 
@@ -90,11 +90,6 @@ def to_raw(value: float, name: str) -> int:
     return round(value * 10)
 
 
-def _checked(message: Message) -> Message:
-    message.validate()
-    return message
-
-
 def position_message(yaw: float = 0.0, roll: float = 0.0, pitch: float = 0.0, *,
                      absolute: bool = True, time_s: float = 2.0,
                      axes: Iterable[str] = AXES) -> PositionControl:
@@ -109,16 +104,15 @@ def position_message(yaw: float = 0.0, roll: float = 0.0, pitch: float = 0.0, *,
         raw[axis] = to_raw(value, f"{axis} angle") if axis in moving else 0
         if axis not in moving:
             ctrl |= _AXIS_INVALID[axis]
-    return _checked(PositionControl(raw["yaw"], raw["roll"], raw["pitch"], ctrl,
-                                    to_raw(time_s, "time")))  # type: ignore[return-value]
+    return PositionControl(raw["yaw"], raw["roll"], raw["pitch"], ctrl, to_raw(time_s, "time"))
 
 
 def speed_message(yaw: float, pitch: float, roll: float = 0.0, *,
                   take_control: bool = True) -> SpeedControl:
     """Speed control in °/s (±360); bit 7 of ctrl_byte takes (or releases) control."""
     ctrl = SPEED_HOLD if take_control else SPEED_RELEASE
-    return _checked(SpeedControl(to_raw(yaw, "yaw speed"), to_raw(roll, "roll speed"),
-                                 to_raw(pitch, "pitch speed"), ctrl))  # type: ignore[return-value]
+    return SpeedControl(to_raw(yaw, "yaw speed"), to_raw(roll, "roll speed"),
+                        to_raw(pitch, "pitch speed"), ctrl)
 
 
 def lookup(table: dict[str, int], value: str | int, what: str) -> int:
@@ -132,14 +126,14 @@ def lookup(table: dict[str, int], value: str | int, what: str) -> int:
 
 
 class PendingReply:
-    """A command on the bus waiting for its reply."""
+    """A command on the bus waiting for its reply; ``raw`` is its packet as sent (and resent)."""
 
-    def __init__(self, request: Message, seq: int) -> None:
+    def __init__(self, request: Message, seq: int, raw: bytes) -> None:
         self.request = request
         self.seq = seq
+        self.raw = raw
         self.key = (request.CMD_SET, request.CMD_ID)
         self.packet: Packet | None = None
-        self.received_at: float | None = None
         self.error: BaseException | None = None
         self._event = threading.Event()
 
@@ -151,8 +145,8 @@ class PendingReply:
         """True once a reply (or a bus failure) arrived."""
         return self._event.wait(timeout)
 
-    def resolve(self, packet: Packet, t: float) -> None:
-        self.packet, self.received_at = packet, t
+    def resolve(self, packet: Packet) -> None:
+        self.packet = packet
         self._event.set()
 
     def fail(self, error: BaseException) -> None:
@@ -246,7 +240,7 @@ class GimbalClient:
                 if self._rx_error is None and not self._closed:
                     self.request(message, retries=0)
                 else:
-                    self.transport.send(message_packet(message, self._next_seq()))
+                    self.transport.send(self._encode(message)[1])
             except (GimbalError, can.CanError, OSError) as exc:
                 log.warning("safety stop (%s): %s", "zero speed" if ctrl & SPEED_TAKE_CONTROL
                             else "release control", exc)
@@ -306,7 +300,7 @@ class GimbalClient:
                 self.stats["stale_replies"] += 1
                 log.debug("reply SEQ 0x%04X matches no outstanding request", packet.seq)
             else:
-                waiter.resolve(packet, t)
+                waiter.resolve(packet)
         else:
             self.stats["ignored"] += 1
 
@@ -340,20 +334,23 @@ class GimbalClient:
 
     # -- sending ---------------------------------------------------------------------------
 
-    def _next_seq(self) -> int:
+    def _encode(self, message: Message, cmd_type: int | None = None) -> tuple[int, bytes]:
+        """The next free SEQ and the packet bytes of ``message`` with it. Encoding validates: a
+        ``RangeError`` leaves the SEQ unused and nothing is sent."""
         with self._lock:
             seq = self._seq
             while seq in self._pending:
                 seq = (seq + 1) & 0xFFFF
+            raw = encode_packet(message_packet(message, seq, cmd_type))
             self._seq = (seq + 1) & 0xFFFF
-            return seq
+            return seq, raw
 
-    def _transmit(self, message: Message, packet: Packet) -> None:
+    def _transmit(self, message: Message, raw: bytes) -> None:
         self._check_alive()
         if isinstance(message, SpeedControl) and message.ctrl_byte & SPEED_TAKE_CONTROL:
             self._speed_engaged = True
         try:
-            self.transport.send(packet)
+            self.transport.send(raw)
         except can.CanError as exc:
             raise BusError(f"CAN send failed: {exc}") from exc
 
@@ -362,13 +359,12 @@ class GimbalClient:
         (or drop it with ``cancel``)."""
         if message.REPLY is None:
             raise ValueError(f"{message.NAME} has no reply; use send()")
-        seq = self._next_seq()
-        packet = message_packet(message, seq, cmd_type)  # validates: RangeError before sending
-        waiter = PendingReply(message, seq)
+        seq, raw = self._encode(message, cmd_type)
+        waiter = PendingReply(message, seq, raw)
         with self._lock:
             self._pending[seq] = waiter
         try:
-            self._transmit(message, packet)
+            self._transmit(message, raw)
         except BaseException:
             self.cancel(waiter)
             raise
@@ -406,13 +402,12 @@ class GimbalClient:
         retries = self.retries if retries is None else retries
         waiter = self.submit(message, cmd_type=REPLY_OPTIONAL if optional else None)
         try:
-            packet = message_packet(message, waiter.seq, REPLY_OPTIONAL if optional else None)
             for attempt in range(retries + 1):
                 if attempt:
                     self.stats["retries"] += 1
                     with self._lock:
                         self._pending.setdefault(waiter.seq, waiter)
-                    self._transmit(message, packet)
+                    self._transmit(message, waiter.raw)
                 if waiter.wait(timeout):
                     break
         finally:
@@ -428,7 +423,7 @@ class GimbalClient:
         """Send a host push (joystick, dial, version, focus position): CmdType 0x00, no reply."""
         if message.REPLY is not None:
             raise ValueError(f"{message.NAME} wants a reply; use request()")
-        self._transmit(message, message_packet(message, self._next_seq()))
+        self._transmit(message, self._encode(message)[1])
 
     def _ask(self, message: Message, reply_type: type[R]) -> R:
         reply = self.request(message)
@@ -493,8 +488,7 @@ class GimbalClient:
     def set_angle_limits(self, pitch_max: int, pitch_min: int, yaw_max: int, yaw_min: int,
                          roll_max: int, roll_min: int) -> None:
         """User angle limits in whole degrees (min values are magnitudes below zero)."""
-        self.request(_checked(SetAngleLimits(1, pitch_max, pitch_min, yaw_max, yaw_min,
-                                             roll_max, roll_min)))
+        self.request(SetAngleLimits(1, pitch_max, pitch_min, yaw_max, yaw_min, roll_max, roll_min))
 
     def get_angle_limits(self) -> AngleLimitsReply:
         """The user angle limits, whole degrees."""
@@ -502,7 +496,7 @@ class GimbalClient:
 
     def set_stiffness(self, pitch: int, roll: int, yaw: int) -> None:
         """Motor stiffness 0..100 per axis."""
-        self.request(_checked(SetMotorStiffness(1, pitch, roll, yaw)))
+        self.request(SetMotorStiffness(1, pitch, roll, yaw))
 
     def get_stiffness(self) -> MotorStiffnessReply:
         """Motor stiffness 0..100 per axis."""
@@ -514,28 +508,28 @@ class GimbalClient:
 
     def version(self, device_id: int = DEVICE_ID_R_SDK) -> VersionReply:
         """A module's version (``reply.version_text`` reads AA.BB.CC.DD)."""
-        return self._ask(_checked(VersionQuery(device_id)), VersionReply)
+        return self._ask(VersionQuery(device_id), VersionReply)
 
     def push_version(self, device_id: int, version: int) -> None:
         """Announce an external device's version to the gimbal (unanswered; repeat at 1 Hz)."""
-        self.send(_checked(VersionPush(device_id, version)))
+        self.send(VersionPush(device_id, version))
 
     def joystick(self, yaw: int, pitch: int, roll: int = 0) -> None:
         """External joystick push, raw -15000..15000 per axis (unanswered)."""
-        self.send(_checked(JoystickPush(pitch_speed=pitch, roll_speed=roll, yaw_speed=yaw)))
+        self.send(JoystickPush(pitch_speed=pitch, roll_speed=roll, yaw_speed=yaw))
 
     def dial(self, speed: int) -> None:
         """External dial push, raw -2048..2048 (unanswered)."""
-        self.send(_checked(DialPush(dial_speed=speed)))
+        self.send(DialPush(dial_speed=speed))
 
     def get_user_params(self, ids: Iterable[int] | None = None) -> tuple[Tlv, ...]:
         """User parameters as TLVs (describe them with ``tlv_params.describe_user_param``)."""
         message = GetUserParams() if ids is None else GetUserParams(tuple(ids))
-        return self.request(_checked(message)).tlvs  # type: ignore[union-attr]
+        return self.request(message).tlvs  # type: ignore[union-attr]
 
     def set_user_params(self, tlvs: Iterable[Tlv]) -> tuple[Tlv, ...]:
         """Write user parameters, e.g. ``[motors_off(True)]``; returns the TLVs echoed back."""
-        return self.request(_checked(SetUserParams(tuple(tlvs)))).tlvs  # type: ignore[union-attr]
+        return self.request(SetUserParams(tuple(tlvs))).tlvs  # type: ignore[union-attr]
 
     def set_work_mode(self, orientation: str | int) -> None:
         """Landscape/portrait orientation (names in ``ORIENTATIONS``)."""
@@ -558,7 +552,7 @@ class GimbalClient:
     def auto_calibration(self, start: bool = True, type: int = 1) -> None:  # noqa: A002
         """Start or stop auto-tuning (type 1 = single pose, the document's advice). The document
         shows no reply, so it is sent reply-optional and silence is accepted."""
-        self.request(_checked(AutoCalibration((autotune(start, type),))), retries=0, optional=True)
+        self.request(AutoCalibration((autotune(start, type),)), retries=0, optional=True)
 
     def activetrack_toggle(self) -> None:
         """Toggle ActiveTrack; reply-optional like ``auto_calibration``, never retried."""
@@ -568,7 +562,7 @@ class GimbalClient:
 
     def focus_position(self, position: int) -> None:
         """Focus motor absolute position 0..4095 (a push: unanswered, up to 100 Hz)."""
-        self.send(_checked(FocusPositionControl(position=position)))
+        self.send(FocusPositionControl(position=position))
 
     def focus_calibration(self, command: str | int) -> bool:
         """Focus calibration command ("auto", "manual", "set-min", "set-max", "stop"); True if
@@ -583,7 +577,7 @@ class GimbalClient:
 
     def camera_action(self, code: int | CameraActionCode) -> None:
         """A camera action (photo, record start/stop, centre focus); never retried."""
-        self._once(_checked(CameraAction(int(code))))
+        self._once(CameraAction(int(code)))
 
     def photo(self) -> None:
         self.camera_action(CameraActionCode.TAKE_PHOTO)
