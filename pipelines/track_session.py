@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 import time
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError
@@ -70,6 +69,9 @@ class _Series:
     pitch_error: list[float] = field(default_factory=list)
     yaw_rate: list[float] = field(default_factory=list)
     pitch_rate: list[float] = field(default_factory=list)
+    # the angular error hypot(yaw, pitch) so far, kept as it goes for the summary
+    error_sum: float = 0.0
+    error_max: float | None = None
 
 
 def control_config(max_speed_dps: float | None) -> ControlConfig:
@@ -161,7 +163,7 @@ class TrackSession:
         self._progress.update(self.frames, lambda: f"{state:<9} yaw {command.yaw_dps:+6.1f} "
                                                    f"pitch {command.pitch_dps:+6.1f} deg/s")
         if time.monotonic() - self._last_summary >= SUMMARY_EVERY_S:
-            self.write_summary()
+            self.write_summary(sync=False)
 
     def _track(self, frame: Frame, stamp: float) -> TargetEstimate | None:
         if self._estimate is None:
@@ -225,6 +227,10 @@ class TrackSession:
         s.pitch_error.append(command.pitch_error_deg)
         s.yaw_rate.append(command.yaw_dps)
         s.pitch_rate.append(command.pitch_dps)
+        error = math.hypot(command.yaw_error_deg, command.pitch_error_deg)
+        s.error_sum += error
+        if s.error_max is None or error > s.error_max or math.isnan(error):
+            s.error_max = error  # a NaN stays, as in a max over the series
 
     # -- recording -----------------------------------------------------------------------
     def _start_recording(self) -> None:
@@ -277,13 +283,13 @@ class TrackSession:
                 ylabels=["deg", "deg/s"])
         return summary
 
-    def write_summary(self) -> dict[str, Any]:
-        """Write the summary as it stands (atomically) and return it."""
+    def write_summary(self, sync: bool = True) -> dict[str, Any]:
+        """Write the summary as it stands (atomically; ``sync``: fsync it) and return it."""
         self._last_summary = time.monotonic()
         elapsed = self._last_summary - self._started
         streamer = self._streamer
         latencies = streamer.latencies() if streamer is not None else []
-        errors = np.hypot(self.series.yaw_error, self.series.pitch_error) if self.series.t else np.zeros(0)
+        s = self.series
         summary = {
             "status": self.reason, "error": self.error,
             "source": self.source.description, "live": self.source.is_live,
@@ -292,13 +298,12 @@ class TrackSession:
             "frames": self.frames, "elapsed_s": elapsed, "fps": self.frames / elapsed if elapsed > 0 else None,
             "frames_dropped": self.source.dropped,
             "states": dict(self.states), "first_acquired_s": self.first_acquired_s,
-            "angular_error_deg": {"mean": float(errors.mean()) if errors.size else None,
-                                  "max": float(errors.max()) if errors.size else None},
+            "angular_error_deg": {"mean": s.error_sum / len(s.t) if s.t else None, "max": s.error_max},
             "latency_ms": {k: (v * 1000.0 if isinstance(v, float) else v)
                            for k, v in latency_percentiles(latencies).items()},
             "speed_commands": dict(streamer.stats) if streamer is not None else {},
             "recording": self.recording,
             "outputs": {k: str(v) for k, v in self.paths.items()},
         }
-        write_summary(self.paths["summary"], summary)
+        write_summary(self.paths["summary"], summary, sync)
         return summary

@@ -31,15 +31,19 @@ def to_plain(value: Any) -> Any:
     raise TypeError(f"cannot write {type(value).__name__} as JSON")
 
 
-def atomic_write(path: str | os.PathLike[str], data: bytes) -> None:
-    """Replace ``path`` with ``data`` in one step: readers see the old or the new file, never a torn one."""
+def atomic_write(path: str | os.PathLike[str], data: bytes, sync: bool = True) -> None:
+    """Replace ``path`` with ``data`` in one step: readers see the old or the new file, never a torn one.
+
+    ``sync`` forces the data to disk before the rename (survives a power loss); without it a
+    process crash still leaves the old or the new file, and the write costs no disk flush."""
     target = Path(path)
     tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
     try:
         with open(tmp, "wb") as handle:
             handle.write(data)
             handle.flush()
-            os.fsync(handle.fileno())
+            if sync:
+                os.fsync(handle.fileno())
         os.replace(tmp, target)
     finally:
         tmp.unlink(missing_ok=True)

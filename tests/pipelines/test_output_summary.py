@@ -43,6 +43,17 @@ def test_unserialisable_summary_leaves_the_file_alone(tmp_path: Path) -> None:
     assert json.loads(path.read_text()) == {"frames": 1}
 
 
+def test_sync_false_skips_only_the_fsync(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = tmp_path / "summary.json"
+    synced: list[int] = []
+    monkeypatch.setattr(os, "fsync", synced.append)
+    write_summary(path, {"frames": 10}, sync=False)
+    assert synced == [] and json.loads(path.read_text()) == {"frames": 10}
+    write_summary(path, {"frames": 20})
+    assert len(synced) == 1 and json.loads(path.read_text()) == {"frames": 20}
+    assert os.listdir(tmp_path) == ["summary.json"]
+
+
 def test_latency_percentiles() -> None:
     stats = latency_percentiles(float(v) for v in range(1, 101))
     assert stats["count"] == 100 and stats["max"] == 100.0

@@ -76,6 +76,12 @@ def test_outputs_are_complete_and_readable(demo_run: dict[str, Any]) -> None:
     assert summary["latency_ms"]["count"] > 50 and summary["latency_ms"]["p50"] > 0
 
 
+def test_summary_angular_error_is_that_of_the_telemetry(demo_run: dict[str, Any]) -> None:
+    errors = [float(np.hypot(*r["error_deg"])) for r in read_telemetry(demo_run["out"] / "telemetry.jsonl")]
+    assert demo_run["summary"]["angular_error_deg"] == pytest.approx(
+        {"mean": sum(errors) / len(errors), "max": max(errors)}, rel=1e-12)
+
+
 # Image axes: x grows to the right, y downwards. Controller: yaw positive to the right, pitch
 # positive upwards (pipelines.control.camera), so a subject below centre needs a negative pitch rate.
 @pytest.mark.parametrize("corner, signs, rate", [
