@@ -159,7 +159,7 @@ class TrackSession:
         self.frames += 1
         state = estimate.state.value if estimate is not None else "acquiring"
         self.states[state] += 1
-        self._write_frame(frame, stamp, estimate, command)
+        self._write_frame(frame, stamp, state, estimate, command)
         self._progress.update(self.frames, lambda: f"{state:<9} yaw {command.yaw_dps:+6.1f} "
                                                    f"pitch {command.pitch_dps:+6.1f} deg/s")
         if time.monotonic() - self._last_summary >= SUMMARY_EVERY_S:
@@ -202,15 +202,13 @@ class TrackSession:
             return None
         return sample.yaw * self.options.yaw_sign, sample.pitch * self.options.pitch_sign
 
-    def _write_frame(self, frame: Frame, stamp: float, estimate: TargetEstimate | None,
+    def _write_frame(self, frame: Frame, stamp: float, state: str, estimate: TargetEstimate | None,
                      command: Any) -> None:
         attitude = self.history.latest()
         record: dict[str, Any] = {"frame": frame.index, "t": stamp,
-                                  "t_run": time.monotonic() - self._started,
-                                  "state": "acquiring" if estimate is None else estimate.state.value}
+                                  "t_run": time.monotonic() - self._started, "state": state}
         if estimate is not None:
             record.update(estimate_fields(estimate))
-            record["frame"] = frame.index
         record.update({"error_deg": [command.yaw_error_deg, command.pitch_error_deg],
                        "rate_dps": [command.yaw_dps, command.pitch_dps], "mode": command.mode,
                        "attitude_deg": None if attitude is None else

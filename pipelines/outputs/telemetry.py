@@ -13,10 +13,9 @@ from tracker.estimate import TargetEstimate
 
 
 def estimate_fields(estimate: TargetEstimate) -> dict[str, Any]:
-    """The tracker part of a telemetry record (keys as documented in docs/outputs.md)."""
+    """The tracker part of a telemetry record (keys as documented in docs/outputs.md); the frame's
+    ``frame`` and ``t`` come from the source's ``Frame``, not from here."""
     return {
-        "frame": estimate.frame_index,
-        "t": estimate.timestamp,
         "box": list(estimate.box),
         "velocity": list(estimate.velocity),
         "confidence": estimate.confidence,

@@ -68,5 +68,5 @@ def test_reader_ignores_only_a_torn_last_line(tmp_path: Path) -> None:
 
 def test_estimate_fields() -> None:
     estimate = TargetEstimate((10.0, 20.0, 30.0, 40.0), (1.5, -2.0), 0.75, TrackState.TRACKING, 1.25, 37)
-    assert estimate_fields(estimate) == {"frame": 37, "t": 1.25, "box": [10.0, 20.0, 30.0, 40.0],
+    assert estimate_fields(estimate) == {"box": [10.0, 20.0, 30.0, 40.0],
                                          "velocity": [1.5, -2.0], "confidence": 0.75, "state": "tracking"}
