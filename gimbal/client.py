@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import atexit
 import logging
-import math
 import signal
 import threading
 import time
@@ -39,7 +38,8 @@ from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, Focu
 from gimbal.messages.motion import (ANGLES_ATTITUDE, ANGLES_JOINT, POSITION_ABSOLUTE,
                                     POSITION_PITCH_INVALID, POSITION_ROLL_INVALID,
                                     POSITION_YAW_INVALID, SPEED_IGNORE_FOCAL_LENGTH,
-                                    SPEED_TAKE_CONTROL, GetAngles, PositionControl, SpeedControl)
+                                    SPEED_TAKE_CONTROL, GetAngles, PositionControl, SpeedControl,
+                                    from_raw, to_raw)
 from gimbal.messages.settings import (FOLLOW_FPV, FOLLOW_LOCK, FOLLOW_YAW, SELFIE, ActiveTrack,
                                       AngleLimitsReply, GetAngleLimits, GetMotorStiffness,
                                       MotorStiffnessReply, RecenterSelfie, SetAngleLimits,
@@ -81,13 +81,6 @@ class Angles:
     yaw: float
     roll: float
     pitch: float
-
-
-def to_raw(value: float, name: str) -> int:
-    """Degrees (or °/s, or s) to the wire's 0.1 units, rounded to the nearest unit."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise RangeError(f"{name}={value!r} is not a finite number")
-    return round(value * 10)
 
 
 def position_message(yaw: float = 0.0, roll: float = 0.0, pitch: float = 0.0, *,
@@ -481,7 +474,7 @@ class GimbalClient:
             raise GimbalError(f"the gimbal has no {kind} angles ready (data_type "
                               f"{getattr(reply, 'data_type', None)})")
         name = next(k for k, v in ANGLE_KINDS.items() if v == code)
-        return Angles(name, reply.yaw / 10, reply.roll / 10, reply.pitch / 10)  # type: ignore[attr-defined]
+        return Angles(name, *(from_raw(getattr(reply, axis)) for axis in AXES))
 
     # -- settings --------------------------------------------------------------------------
 

@@ -21,7 +21,7 @@ import can
 
 from gimbal.client import SPEED_HOLD, GimbalClient, PendingReply
 from gimbal.errors import BusError, GimbalError, RangeError
-from gimbal.messages.motion import SpeedControl
+from gimbal.messages.motion import SpeedControl, to_raw
 
 log = logging.getLogger(__name__)
 
@@ -42,7 +42,7 @@ class _Setpoint:
 def _clamped_raw(value: float, name: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
         raise RangeError(f"{name}={value!r} is not a number")
-    return round(max(-MAX_SPEED_DPS, min(MAX_SPEED_DPS, value)) * 10)
+    return to_raw(max(-MAX_SPEED_DPS, min(MAX_SPEED_DPS, value)), name)
 
 
 class SpeedStreamer:

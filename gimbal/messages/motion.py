@@ -1,9 +1,11 @@
 """Position control (0x0E/0x00), speed control (0x01) and angle read-out (0x02)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+from gimbal.errors import RangeError
 from gimbal.messages.base import GIMBAL_CMD_SET, register
 from gimbal.messages.kinds import Command, Reply, ReturnCodeReply
 
@@ -24,6 +26,18 @@ SPEED_IGNORE_FOCAL_LENGTH = 0x08  # bit 3: speed does not depend on the camera's
 ANGLES_NONE = 0x00
 ANGLES_ATTITUDE = 0x01
 ANGLES_JOINT = 0x02
+
+
+def to_raw(value: float, name: str) -> int:
+    """Degrees (or °/s, or s) to the wire's 0.1 units, rounded to the nearest unit."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise RangeError(f"{name}={value!r} is not a finite number")
+    return round(value * 10)
+
+
+def from_raw(raw: int) -> float:
+    """The wire's 0.1 units to degrees (or °/s, or s)."""
+    return raw / 10
 
 
 @register

@@ -155,7 +155,8 @@ class GimbalModel:
         att, joint = self.attitude(), self.joint()
         return telemetry.ParameterPush(
             telemetry.FLAG_ANGLES_VALID | telemetry.FLAG_LIMITS_VALID | telemetry.FLAG_STIFFNESS_VALID,
-            *(_deci(a) for a in att), *(_deci(a) for a in joint), **self.limits,
+            *(motion.to_raw(a, "attitude") for a in att), *(motion.to_raw(a, "joint") for a in joint),
+            **self.limits,
             pitch_stiffness=self.stiffness["pitch"], yaw_stiffness=self.stiffness["yaw"],
             roll_stiffness=self.stiffness["roll"])
 
@@ -170,11 +171,11 @@ class GimbalModel:
         for name, raw in values.items():
             if msg.ctrl_byte & POSITION_INVALID_BITS[name]:
                 continue
-            target = raw / 10.0 if absolute else self.axes[name].angle + raw / 10.0
+            target = motion.from_raw(raw) if absolute else self.axes[name].angle + motion.from_raw(raw)
             if not self.axis_range(name).contains(target):
                 return msg.REPLY(FAILED)
             targets[name] = target
-        self._move_all(targets, now, msg.time_for_action / 10.0, self.config.max_speed_dps)
+        self._move_all(targets, now, motion.from_raw(msg.time_for_action), self.config.max_speed_dps)
         self.selfie = False
         return msg.REPLY(OK)
 
@@ -190,7 +191,7 @@ class GimbalModel:
         self.speed_control = True
         speeds = (msg.yaw_speed, msg.roll_speed, msg.pitch_speed)
         for name, raw, sign in zip(AXES, speeds, self.config.speed_signs):
-            self.axes[name].set_speed(sign * raw / 10.0, now, self.config.speed_timeout_s)
+            self.axes[name].set_speed(sign * motion.from_raw(raw), now, self.config.speed_timeout_s)
         return msg.REPLY(OK)
 
     def _joystick(self, msg: external.JoystickPush, now: float) -> None:
@@ -214,7 +215,7 @@ class GimbalModel:
         if msg.ctrl_byte == motion.ANGLES_NONE:
             return msg.REPLY(OK, motion.ANGLES_NONE, 0, 0, 0)
         angles = self.attitude() if msg.ctrl_byte == motion.ANGLES_ATTITUDE else self.joint()
-        return msg.REPLY(OK, msg.ctrl_byte, *(_deci(a) for a in angles))
+        return msg.REPLY(OK, msg.ctrl_byte, *(motion.to_raw(a, "angle") for a in angles))
 
     # --- settings ---------------------------------------------------------------------------
 
@@ -364,11 +365,6 @@ class GimbalModel:
             focus={"position": self.focus.position, "target": self.focus.target, "state": self.focus.state},
             recording=self.recording, photos=self.photos, external_versions=dict(self.external_versions),
             commands=dict(self.commands), sent=dict(sent), faults=dict(faults))
-
-
-def _deci(angle: float) -> int:
-    """Degrees to the wire's 0.1° units."""
-    return int(round(angle * 10.0))
 
 
 def _clamp(angle: float, allowed: AxisRange) -> float:

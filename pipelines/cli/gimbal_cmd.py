@@ -22,7 +22,7 @@ from gimbal.messages import Message, message_packet
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (DialPush, FocusCalibration, FocusPositionControl,
                                       FocusPositionQuery, JoystickPush)
-from gimbal.messages.motion import ANGLES_ATTITUDE, ANGLES_JOINT, GetAngles
+from gimbal.messages.motion import ANGLES_ATTITUDE, ANGLES_JOINT, GetAngles, from_raw
 from gimbal.messages.settings import (ActiveTrack, GetAngleLimits, GetMotorStiffness,
                                       RecenterSelfie, SetAngleLimits, SetFollowMode,
                                       SetMotorStiffness, SetWorkMode, SELFIE)
@@ -59,7 +59,7 @@ class Command:
 # -- helpers ---------------------------------------------------------------------------------
 
 def _deg(raw: int | None) -> float | None:
-    return None if raw is None else raw / 10
+    return None if raw is None else from_raw(raw)
 
 
 def _angles(client: GimbalClient, kind: str) -> Result:

@@ -19,7 +19,7 @@ import can
 from gimbal.client import SPEED_HOLD, SPEED_RELEASE, exit_on_signals
 from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
 from gimbal.messages import message_packet
-from gimbal.messages.motion import SPEED_TAKE_CONTROL, SpeedControl
+from gimbal.messages.motion import SPEED_TAKE_CONTROL, SpeedControl, from_raw
 from gimbal.transport import CanTransport
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
@@ -84,7 +84,7 @@ class ReplaySummary:
             if record["timestamp"] is not None:
                 self.speed_times.append(record["timestamp"])
             speeds = (fields.get(k, 0) for k in ("yaw_speed", "roll_speed", "pitch_speed"))
-            self.max_speed_dps = max(self.max_speed_dps, *(abs(v) / 10.0 for v in speeds))
+            self.max_speed_dps = max(self.max_speed_dps, *(abs(from_raw(v)) for v in speeds))
 
     @property
     def holds_control(self) -> bool:
@@ -103,9 +103,10 @@ class ReplaySummary:
                 "speed_commands": len(self.speed_times), "speed_rate_hz": self.speed_rate_hz(),
                 "max_speed_dps": self.max_speed_dps,
                 "last_speed": None if last is None else {
-                    "yaw_dps": last.get("yaw_speed", 0) / 10.0, "roll_dps": last.get("roll_speed", 0) / 10.0,
-                    "pitch_dps": last.get("pitch_speed", 0) / 10.0, "ctrl_byte": last.get("ctrl_byte"),
-                    "released": not self.holds_control}}
+                    "yaw_dps": from_raw(last.get("yaw_speed", 0)),
+                    "roll_dps": from_raw(last.get("roll_speed", 0)),
+                    "pitch_dps": from_raw(last.get("pitch_speed", 0)),
+                    "ctrl_byte": last.get("ctrl_byte"), "released": not self.holds_control}}
 
     def text(self) -> str:
         d = self.as_dict()
@@ -141,9 +142,9 @@ def format_record(record: Record, t0: float | None) -> str:
 
 def _field(name: str, value: Any, record: Record) -> str:
     if isinstance(value, int) and name.endswith("_angle"):
-        return f"{name.removesuffix('_angle')}={value / 10.0:+.1f}deg"
+        return f"{name.removesuffix('_angle')}={from_raw(value):+.1f}deg"
     if isinstance(value, int) and name.endswith("_speed"):
-        return f"{name.removesuffix('_speed')}={value / 10.0:+.1f}deg/s"
+        return f"{name.removesuffix('_speed')}={from_raw(value):+.1f}deg/s"
     if name == "ctrl_byte" and isinstance(value, int):
         return f"ctrl=0x{value:02X}"
     if name == "return_code":

@@ -19,7 +19,7 @@ from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatus
 from gimbal.messages.external import (DialPush, FocusCalibration, FocusCalibrationReply,
                                       FocusPositionControl, FocusPositionQuery, JoystickPush)
 from gimbal.messages.motion import (AnglesReply, GetAngles, PositionControl, PositionControlReply,
-                                    SpeedControl, SpeedControlReply)
+                                    SpeedControl, SpeedControlReply, from_raw, to_raw)
 from gimbal.messages.settings import SetAngleLimits, SetMotorStiffness
 from gimbal.messages.telemetry import ParameterPush, VersionPush, VersionQuery, VersionReply
 from gimbal.messages.tlv_params import (AUTOTUNE, AutoCalibration, CalibrationStatusPush,
@@ -445,3 +445,11 @@ def test_range_errors_speak_in_degrees_where_the_field_has_a_unit():
         PositionControl(yaw_angle=3000).encode_payload()
     with pytest.raises(RangeError, match=r"\(-400°/s: allowed -360\.\.360°/s\)"):
         SpeedControl(pitch_speed=-4000).encode_payload()
+
+
+def test_degrees_to_and_from_the_wires_tenths() -> None:
+    assert [to_raw(v, "yaw") for v in (3.2, -180, 0.04, 0.06)] == [32, -1800, 0, 1]
+    assert from_raw(-1799) == -179.9 and from_raw(5) == 0.5
+    for bad in (float("nan"), float("inf"), True, "1"):
+        with pytest.raises(RangeError, match="yaw="):
+            to_raw(bad, "yaw")  # type: ignore[arg-type]
