@@ -28,6 +28,7 @@ from pipelines.progress import ProgressReporter
 from pipelines.sources import Frame, FrameSource
 from tracker import make_tracker
 from tracker.detectors import Detector, make_detector
+from tracker.datasets import ASSUMED_FPS
 from tracker.estimate import TargetEstimate, TrackState
 
 log = logging.getLogger(__name__)
@@ -126,7 +127,7 @@ class TrackSession:
         self.video: BackgroundVideoWriter | None = None
         if options.video:
             self.paths["video"] = out / "annotated.avi"
-            self.video = BackgroundVideoWriter(self.paths["video"], source.size, source.fps or 30.0)
+            self.video = BackgroundVideoWriter(self.paths["video"], source.size, source.fps or ASSUMED_FPS)
 
     # -- the run -------------------------------------------------------------------------
     def start(self) -> None:

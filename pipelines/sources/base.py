@@ -6,6 +6,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from types import TracebackType
 
+import cv2
 import numpy as np
 
 
@@ -83,3 +84,9 @@ class FrameSource(ABC):
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self._description}>"
+
+
+def nominal_fps(capture: cv2.VideoCapture) -> float | None:
+    """The frame rate a capture reports, or ``None`` when it reports none or nonsense."""
+    fps = capture.get(cv2.CAP_PROP_FPS)
+    return fps if 0 < fps < 1000 else None

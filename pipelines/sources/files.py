@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import queue
-import re
 import threading
 import time
 from abc import abstractmethod
@@ -12,10 +11,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pipelines.sources.base import Frame, FrameSource, SourceError
+from pipelines.sources.base import Frame, FrameSource, SourceError, nominal_fps
+from tracker.datasets import ASSUMED_FPS, list_images
 
-#: Frame rate assumed for timestamps when a file does not tell its own (OTB sequences are 30 fps).
-ASSUMED_FPS = 30.0
+#: The image files an image folder source reads (a subset of what tracker.datasets lists).
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
 
 
@@ -57,16 +56,18 @@ _END = object()  # the decoder thread's end-of-file marker
 class FileSource(FrameSource):
     """A recorded sequence: nothing is ever dropped. A decoder thread reads up to ``PREFETCH``
     frames ahead (OpenCV releases the GIL while decoding), so decoding overlaps the consumer's
-    work on another core; a decode error reaches ``read`` in order."""
+    work on another core; a decode error reaches ``read`` in order. Timestamps are paced at
+    ``fps``, or ``ASSUMED_FPS`` when the file does not tell its rate."""
 
     PREFETCH = 8
 
     def __init__(self, description: str, first: np.ndarray, fps: float | None,
-                 frame_count: int | None, pacer: Pacer) -> None:
+                 frame_count: int | None, realtime: bool, clock: Callable[[], float],
+                 sleep: Callable[[float], None]) -> None:
         height, width = first.shape[:2]
         super().__init__(description, (width, height), fps, frame_count, is_live=False)
         self._pending: np.ndarray | None = first
-        self._pacer = pacer
+        self._pacer = Pacer(fps or ASSUMED_FPS, realtime, clock, sleep)
         self._index = 0
         self._closed = False
         self._ended = False
@@ -143,12 +144,10 @@ class VideoFileSource(FileSource):
         if not ok or first is None:
             capture.release()
             raise SourceError(f"no frame decodes from {path}: unsupported codec or corrupt file")
-        nominal = capture.get(cv2.CAP_PROP_FPS)
-        fps = fps or (nominal if 0 < nominal < 1000 else None)
         count = int(capture.get(cv2.CAP_PROP_FRAME_COUNT))
         self._capture = capture
-        super().__init__(str(path), first, fps, count if count > 0 else None,
-                         Pacer(fps or ASSUMED_FPS, realtime, clock, sleep))
+        super().__init__(str(path), first, fps or nominal_fps(capture), count if count > 0 else None,
+                         realtime, clock, sleep)
 
     def _load(self, index: int) -> np.ndarray | None:
         ok, image = self._capture.read()
@@ -159,23 +158,17 @@ class VideoFileSource(FileSource):
         self._capture.release()
 
 
-def _natural_key(path: Path) -> list[int | str]:
-    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", path.name)]
-
-
 class ImageFolderSource(FileSource):
     """A folder of .jpg/.png images in natural name order (``img2`` before ``img10``)."""
 
     def __init__(self, path: Path, realtime: bool = False, fps: float | None = None,
                  clock: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep) -> None:
-        files = sorted((p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()),
-                       key=_natural_key)
+        files = [p for p in list_images(path) if p.suffix.lower() in IMAGE_SUFFIXES]
         if not files:
             raise SourceError(f"no .jpg or .png images in folder {path}")
         self._files = files
-        super().__init__(str(path), self._imread(files[0]), fps, len(files),
-                         Pacer(fps or ASSUMED_FPS, realtime, clock, sleep))
+        super().__init__(str(path), self._imread(files[0]), fps, len(files), realtime, clock, sleep)
 
     @staticmethod
     def _imread(path: Path) -> np.ndarray:

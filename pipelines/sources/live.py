@@ -9,7 +9,7 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from pipelines.sources.base import Frame, FrameSource, SourceError
+from pipelines.sources.base import Frame, FrameSource, SourceError, nominal_fps
 
 DEFAULT_STALL_TIMEOUT = 2.0
 DEFAULT_OPEN_TIMEOUT = 10.0
@@ -140,18 +140,13 @@ class LiveSource(FrameSource):
             self._grabber.stop()
 
 
-def _nominal_fps(capture: cv2.VideoCapture) -> float | None:
-    fps = capture.get(cv2.CAP_PROP_FPS)
-    return fps if 0 < fps < 1000 else None
-
-
 def open_camera(index: int, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
                 open_timeout: float = DEFAULT_OPEN_TIMEOUT) -> LiveSource:
     """Camera number ``index`` through OpenCV's default backend."""
     capture = cv2.VideoCapture(index)
     if not capture.isOpened():
         raise SourceError(f"camera {index} does not open (not connected, busy or no permission)")
-    return LiveSource(capture, f"camera {index}", _nominal_fps(capture), stall_timeout, open_timeout)
+    return LiveSource(capture, f"camera {index}", nominal_fps(capture), stall_timeout, open_timeout)
 
 
 def open_stream(url: str, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
@@ -162,4 +157,4 @@ def open_stream(url: str, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
     capture = cv2.VideoCapture(url, cv2.CAP_FFMPEG, params)
     if not capture.isOpened():
         raise SourceError(f"cannot open stream {url} within {open_timeout:g} s")
-    return LiveSource(capture, url, _nominal_fps(capture), stall_timeout, open_timeout)
+    return LiveSource(capture, url, nominal_fps(capture), stall_timeout, open_timeout)

@@ -96,6 +96,19 @@ def test_image_folder_in_natural_order(tmp_path: Path, frame_image) -> None:
     assert [f.timestamp for f in frames] == pytest.approx([0, 1 / ASSUMED_FPS, 2 / ASSUMED_FPS])
 
 
+def test_image_folder_reads_only_jpg_and_png_files(tmp_path: Path, frame_image) -> None:
+    """Other image types tracker.datasets lists (.bmp, .tif, .webp) and folders are left out."""
+    cv2.imwrite(str(tmp_path / "1.jpeg"), frame_image(0))
+    cv2.imwrite(str(tmp_path / "2.bmp"), frame_image(1))
+    cv2.imwrite(str(tmp_path / "3.tif"), frame_image(2))
+    (tmp_path / "4.png").mkdir()
+    cv2.imwrite(str(tmp_path / "10.PNG"), frame_image(3))
+    with open_source(str(tmp_path)) as source:
+        assert source.frame_count == 2
+        frames = list(source)
+    assert [brightness(f.image) for f in frames] == pytest.approx([20, 50], abs=3)
+
+
 def test_missing_path(tmp_path: Path) -> None:
     with pytest.raises(SourceError, match="no such video file or image folder"):
         open_source(str(tmp_path / "nope.mp4"))
