@@ -148,7 +148,8 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
                 view = vc.render(frame, yaw, pitch)
                 box = vc.box_to_view(source_box, yaw, pitch)
                 pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box,
-                                         _sample(vc, source_box, yaw, pitch, t_cap - t0), (yaw, pitch)))
+                                         CentringSample(t_cap - t0, *vc.center_offset(source_box, yaw, pitch)),
+                                         (yaw, pitch)))
                 index += 1
                 frame = next(frames, None)
             streamer.stop()
@@ -158,12 +159,3 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
         host_bus.shutdown()
     return LoopResult(settings, steps, summarize([s.sample for s in steps]), latencies)
 
-
-def _sample(vc: VirtualCamera, box: Box, yaw: float, pitch: float, t: float) -> CentringSample:
-    x, y, w, h = box
-    (cx, cy), = vc.to_view(np.array([[x + w / 2, y + h / 2]]), yaw, pitch)
-    cam = vc.camera
-    if np.isnan(cx):
-        return CentringSample(t, 1.0, 0.0, False)
-    inside = 0.0 <= cx < cam.width and 0.0 <= cy < cam.height
-    return CentringSample(t, (cx - cam.cx) / cam.diagonal_px, (cy - cam.cy) / cam.diagonal_px, inside)

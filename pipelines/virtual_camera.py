@@ -79,13 +79,20 @@ class VirtualCamera:
         (x0, y0), (x1, y1) = corners.min(axis=0), corners.max(axis=0)
         return (float(x0), float(y0), float(x1 - x0), float(y1 - y0))
 
-    def center_error(self, box: Box, yaw: float, pitch: float) -> tuple[float, bool]:
-        """Distance from the box centre to the view centre as a fraction of the view diagonal,
-        and whether the centre lies inside the view."""
+    def center_offset(self, box: Box, yaw: float, pitch: float) -> tuple[float, float, bool]:
+        """Signed offset (dx, dy) of the box centre from the view centre as fractions of the view
+        diagonal (right, down positive), and whether the centre lies inside the view; a centre
+        behind the view is (1, 0) and outside."""
         x, y, w, h = box
         (cx, cy), = self.to_view(np.array([[x + w / 2, y + h / 2]]), yaw, pitch)
         cam = self.camera
         if np.isnan(cx):
-            return 1.0, False
+            return 1.0, 0.0, False
         inside = 0.0 <= cx < cam.width and 0.0 <= cy < cam.height
-        return float(np.hypot(cx - cam.cx, cy - cam.cy) / cam.diagonal_px), inside
+        return (cx - cam.cx) / cam.diagonal_px, (cy - cam.cy) / cam.diagonal_px, inside
+
+    def center_error(self, box: Box, yaw: float, pitch: float) -> tuple[float, bool]:
+        """Distance from the box centre to the view centre as a fraction of the view diagonal,
+        and whether the centre lies inside the view."""
+        dx, dy, inside = self.center_offset(box, yaw, pitch)
+        return float(np.hypot(dx, dy)), inside
