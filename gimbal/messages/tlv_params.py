@@ -22,6 +22,8 @@ CALIBRATION_STATUS_LENGTH = 6
 
 
 def param_table(table: int) -> Tlv:
+    if table not in range(3):
+        raise RangeError(f"param_table={table} is outside 0..2")
     return Tlv(PARAM_TABLE, bytes((table,)))
 
 

@@ -305,8 +305,6 @@ def _user_params_args(p: argparse.ArgumentParser) -> None:
 def _user_params_tlvs(args: argparse.Namespace) -> list[Tlv]:
     tlvs = []
     if args.param_table is not None:
-        if not 0 <= args.param_table <= 2:
-            raise RangeError(f"param_table={args.param_table} is outside 0..2")
         tlvs.append(param_table(args.param_table))
     if args.roll360_mode is not None:
         tlvs.append(roll360_mode(next(k for k, v in ROLL360_MODES.items() if v == args.roll360_mode)))

@@ -212,6 +212,9 @@ def test_tlv_refusals() -> None:
             check_user_param(tlv)
     with pytest.raises(RangeError):
         roll360_mode(4)
+    for table in (3, -1, 256):
+        with pytest.raises(RangeError, match=f"param_table={table} is outside 0..2"):
+            param_table(table)
     with pytest.raises(RangeError):
         autotune(True, 2)
     with pytest.raises(RangeError):
