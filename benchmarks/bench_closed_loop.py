@@ -29,6 +29,7 @@ from gimbal.sim import SimConfig
 from pipelines.closed_loop import LoopSettings, run_closed_loop
 from pipelines.control.direction import DirectionFilter
 from pipelines.virtual_camera import VirtualCamera
+from tracker.boxes import center
 from tracker.data_paths import shared_sequences
 from tracker.datasets import load_sequence
 
@@ -52,7 +53,7 @@ def _truth_angles(path: Path) -> tuple[np.ndarray, float]:
     seq = load_sequence(path)
     first = cv2.imread(str(seq.frame_paths[0]))
     vc = VirtualCamera((first.shape[1], first.shape[0]))
-    angles = np.array([vc.source.pixel_to_angles(x + w / 2, y + h / 2) for x, y, w, h in seq.groundtruth])
+    angles = np.array([vc.source.pixel_to_angles(*center(box)) for box in seq.groundtruth])
     return angles, math.radians(1.0) * vc.camera.focal_px / vc.camera.diagonal_px
 
 

@@ -22,7 +22,8 @@ from gimbal.sim import SimConfig, start_in_process
 from pipelines.control.attitude import AttitudeHistory
 from pipelines.control.controller import ControlConfig, RateCommand, make_controller
 from pipelines.control.metrics import CentringSample, summarize
-from pipelines.virtual_camera import Box, VirtualCamera
+from pipelines.virtual_camera import VirtualCamera
+from tracker.boxes import Box, center
 from tracker.datasets import load_sequence
 from tracker.estimate import TargetEstimate, TrackState
 
@@ -65,7 +66,10 @@ class OracleTracker:
         self.width, self.height = width, height
 
     def estimate(self, box: Box | None, timestamp: float, index: int) -> TargetEstimate:
-        found = box is not None and 0 <= box[0] + box[2] / 2 < self.width and 0 <= box[1] + box[3] / 2 < self.height
+        found = False
+        if box is not None:
+            cx, cy = center(box)
+            found = 0 <= cx < self.width and 0 <= cy < self.height
         return TargetEstimate(box or (0.0, 0.0, 0.0, 0.0), (0.0, 0.0), 1.0 if found else 0.0,
                               TrackState.TRACKING if found else TrackState.LOST, timestamp, index)
 

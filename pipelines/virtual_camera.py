@@ -12,12 +12,10 @@ import numpy as np
 
 from pipelines.control.camera import CameraModel
 from pipelines.control.direction import rotation_matrix
+from tracker.boxes import Box, center
 
 # (forward, right, up) -> OpenCV camera axes (x right, y down, z forward)
 _TO_CV = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
-
-Box = tuple[float, float, float, float]
-
 
 def _intrinsics(cam: CameraModel) -> np.ndarray:
     return np.array([[cam.focal_px, 0.0, cam.cx], [0.0, cam.focal_px, cam.cy], [0.0, 0.0, 1.0]])
@@ -83,8 +81,7 @@ class VirtualCamera:
         """Signed offset (dx, dy) of the box centre from the view centre as fractions of the view
         diagonal (right, down positive), and whether the centre lies inside the view; a centre
         behind the view is (1, 0) and outside."""
-        x, y, w, h = box
-        (cx, cy), = self.to_view(np.array([[x + w / 2, y + h / 2]]), yaw, pitch)
+        (cx, cy), = self.to_view(np.array([center(box)]), yaw, pitch)
         cam = self.camera
         if np.isnan(cx):
             return 1.0, 0.0, False

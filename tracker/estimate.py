@@ -4,6 +4,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
+from tracker.boxes import Box, center
+
 
 class TrackState(str, Enum):
     """Where the tracker stands with its subject."""
@@ -22,7 +24,7 @@ class TargetEstimate:
     (the source's clock, monotonic within a run).
     """
 
-    box: tuple[float, float, float, float]
+    box: Box
     velocity: tuple[float, float]
     confidence: float
     state: TrackState
@@ -31,8 +33,7 @@ class TargetEstimate:
 
     @property
     def center(self) -> tuple[float, float]:
-        x, y, w, h = self.box
-        return (x + w / 2.0, y + h / 2.0)
+        return center(self.box)
 
     @property
     def found(self) -> bool:
