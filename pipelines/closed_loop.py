@@ -23,6 +23,7 @@ from pipelines.control.attitude import AttitudeHistory
 from pipelines.control.controller import ControlConfig, RateCommand, make_controller
 from pipelines.control.metrics import CentringSample, summarize
 from pipelines.virtual_camera import VirtualCamera
+from tracker import make_tracker
 from tracker.boxes import Box, center
 from tracker.datasets import load_sequence
 from tracker.estimate import TargetEstimate, TrackState
@@ -47,8 +48,6 @@ class LoopStep:
 
     sample: CentringSample
     command: RateCommand
-    attitude: tuple[float, float]  # true gimbal (yaw, pitch) at capture
-    processed_at: float  # seconds from the start
 
 
 @dataclass
@@ -82,14 +81,6 @@ class _Captured:
     view: np.ndarray
     box: Box | None
     sample: CentringSample
-    attitude: tuple[float, float]
-
-
-def _make_tracker(name: str, model_dir: Path | None = None) -> object:
-    import tracker
-    if not hasattr(tracker, "make_tracker"):
-        raise ValueError(f"tracker {name!r} is not available here (only {ORACLE!r})")
-    return tracker.make_tracker(name, model_dir=model_dir)
 
 
 def _sleep_until(t: float) -> None:
@@ -108,7 +99,7 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
     vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
     controller = make_controller(settings.controller, camera=vc.camera, config=settings.control)
     oracle = OracleTracker(vc.camera.width, vc.camera.height)
-    subject = None if settings.tracker == ORACLE else _make_tracker(settings.tracker)
+    subject = None if settings.tracker == ORACLE else make_tracker(settings.tracker)
 
     host_bus, sim = start_in_process(SimConfig(yaw_continuous=True))
     steps: list[LoopStep] = []
@@ -135,7 +126,7 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
                 now = time.monotonic()
                 cmd = controller.update(est, None if att is None else (att.yaw, att.pitch), now)
                 streamer.set(cmd.yaw_dps, cmd.pitch_dps, stamp=item.t)
-                steps.append(LoopStep(item.sample, cmd, item.attitude, now - t0))
+                steps.append(LoopStep(item.sample, cmd))
 
             frame: np.ndarray | None = first
             index = 0
@@ -152,8 +143,7 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
                 view = vc.render(frame, yaw, pitch)
                 box = vc.box_to_view(source_box, yaw, pitch)
                 pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box,
-                                         CentringSample(t_cap - t0, *vc.center_offset(source_box, yaw, pitch)),
-                                         (yaw, pitch)))
+                                         CentringSample(t_cap - t0, *vc.center_offset(source_box, yaw, pitch))))
                 index += 1
                 frame = next(frames, None)
             streamer.stop()

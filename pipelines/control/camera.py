@@ -41,10 +41,6 @@ class CameraModel:
         return math.degrees(2.0 * math.atan(self.cx / self.focal_px))
 
     @property
-    def vfov_deg(self) -> float:
-        return math.degrees(2.0 * math.atan(self.cy / self.focal_px))
-
-    @property
     def diagonal_px(self) -> float:
         return math.hypot(self.width, self.height)
 

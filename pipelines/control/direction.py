@@ -81,10 +81,6 @@ class DirectionFilter:
         self._kf: KalmanFilter | None = None
         self._t = 0.0
 
-    @property
-    def initialized(self) -> bool:
-        return self._kf is not None
-
     def reset(self) -> None:
         self._kf = None
 
