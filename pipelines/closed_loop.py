@@ -106,8 +106,7 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
     try:
         with GimbalClient(host_bus) as client:
             history = AttitudeHistory()
-            client.on_push(ParameterPush, history.on_push)
-            client.set_push(True)
+            history.attach(client)
             client.wait_for_push(ParameterPush, 1.0)
             streamer = client.speed_streamer()
             pending: deque[_Captured] = deque()

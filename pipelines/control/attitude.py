@@ -3,10 +3,15 @@ from __future__ import annotations
 
 import bisect
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from gimbal.messages.telemetry import FLAG_ANGLES_VALID, ParameterPush
 from pipelines.control.direction import wrap_deg
+
+if TYPE_CHECKING:
+    from gimbal.client import GimbalClient
 
 RAW_DEG = 0.1  # the DJI R SDK reports angles in 0.1 deg
 
@@ -57,6 +62,13 @@ class AttitudeHistory:
         if not msg.ctrl_byte & FLAG_ANGLES_VALID or msg.pitch_angle is None:
             return
         self.add_raw(t, msg.yaw_angle, msg.roll_angle, msg.pitch_angle)
+
+    def attach(self, client: GimbalClient) -> Callable[[], None]:
+        """Record every ``ParameterPush`` ``client`` receives and enable the push; returns the
+        unsubscribe function."""
+        unsubscribe = client.on_push(ParameterPush, self.on_push)
+        client.set_push(True)
+        return unsubscribe
 
     def latest(self) -> Attitude | None:
         return self._samples[-1] if self._samples else None

@@ -48,3 +48,21 @@ def test_push_callback_reads_raw_fields_and_skips_invalid_angles():
     h.on_push(ParameterPush(ctrl_byte=1, yaw_angle=-1795, roll_angle=3, pitch_angle=-120), 2.0)
     a = h.latest()
     assert (a.yaw, a.roll, a.pitch, a.timestamp) == pytest.approx((-179.5, 0.3, -12.0, 2.0))
+
+
+def test_attach_subscribes_to_the_attitude_push_and_enables_it():
+    calls = []
+
+    class Client:
+        def on_push(self, cls, callback):
+            calls.append(("on_push", cls, callback))
+            return lambda: calls.append(("unsubscribe",))
+
+        def set_push(self, enabled):
+            calls.append(("set_push", enabled))
+
+    h = AttitudeHistory()
+    unsubscribe = h.attach(Client())
+    assert calls == [("on_push", ParameterPush, h.on_push), ("set_push", True)]
+    unsubscribe()
+    assert calls[-1] == ("unsubscribe",)
