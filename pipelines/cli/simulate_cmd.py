@@ -8,6 +8,8 @@ from pathlib import Path
 from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, run_closed_loop
 from pipelines.cli.common import CliError
 from pipelines.control.controller import controller_names
+from pipelines.outputs.latency import latency_percentiles
+from pipelines.outputs.summary import write_summary
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -48,12 +50,12 @@ def _size(text: str) -> tuple[int, int]:
 
 def summary_of(result: LoopResult) -> dict[str, object]:
     s = result.settings
-    lat = sorted(result.command_latencies)
+    median = latency_percentiles(result.command_latencies)["p50"]
     return {
         **result.summary,
         "controller": s.controller, "tracker": s.tracker, "latency_ms": s.latency_s * 1000.0,
         "fov_deg": s.hfov_deg, "size": list(s.out_size),
-        "median_capture_to_bus_ms": lat[len(lat) // 2] * 1000.0 if lat else None,
+        "median_capture_to_bus_ms": None if median is None else median * 1000.0,
     }
 
 
@@ -83,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         write_plot(args.out / "plot.png", result)
-        (args.out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        write_summary(args.out / "summary.json", summary)
     if args.json:
         print(json.dumps(summary))
         return 0
