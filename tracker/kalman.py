@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
 from tracker.boxes import Box, center, from_center
@@ -44,11 +45,8 @@ class BoxKalman:
             f = np.eye(6)
             f[0, 2] = f[1, 3] = dt
             q = np.zeros((6, 6))
-            a2 = (self.accel * size) ** 2
-            for pos, vel in ((0, 2), (1, 3)):
-                q[pos, pos] = a2 * dt**4 / 4
-                q[pos, vel] = q[vel, pos] = a2 * dt**3 / 2
-                q[vel, vel] = a2 * dt**2
+            q[:4, :4] = Q_discrete_white_noise(dim=2, dt=dt, var=(self.accel * size) ** 2, block_size=2,
+                                               order_by_dim=False)  # cx, cy, vx, vy
             q[4, 4] = q[5, 5] = (self.size_rate * size) ** 2 * dt
             self._kf.predict(F=f, Q=q)
         return self.box
