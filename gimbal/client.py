@@ -35,11 +35,9 @@ from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQ
 from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, FocusPositionReply,
                                       JoystickPush)
-from gimbal.messages.motion import (ANGLES_ATTITUDE, ANGLES_JOINT, POSITION_ABSOLUTE,
-                                    POSITION_PITCH_INVALID, POSITION_ROLL_INVALID,
-                                    POSITION_YAW_INVALID, SPEED_IGNORE_FOCAL_LENGTH,
-                                    SPEED_TAKE_CONTROL, GetAngles, PositionControl, SpeedControl,
-                                    from_raw, to_raw)
+from gimbal.messages.motion import (ANGLES_ATTITUDE, ANGLES_JOINT, AXES, POSITION_ABSOLUTE,
+                                    POSITION_INVALID, SPEED_IGNORE_FOCAL_LENGTH, SPEED_TAKE_CONTROL,
+                                    GetAngles, PositionControl, SpeedControl, from_raw, to_raw)
 from gimbal.messages.settings import (FOLLOW_FPV, FOLLOW_LOCK, FOLLOW_YAW, SELFIE, ActiveTrack,
                                       AngleLimitsReply, GetAngleLimits, GetMotorStiffness,
                                       MotorStiffnessReply, RecenterSelfie, SetAngleLimits,
@@ -59,9 +57,6 @@ log = logging.getLogger(__name__)
 
 FIRST_SEQ = 0x1122  # DJI's demo starts here
 RX_POLL_S = 0.05  # how often the receive thread looks at the closing flag
-AXES = ("yaw", "roll", "pitch")
-_AXIS_INVALID = {"yaw": POSITION_YAW_INVALID, "roll": POSITION_ROLL_INVALID,
-                 "pitch": POSITION_PITCH_INVALID}
 ANGLE_KINDS = {"attitude": ANGLES_ATTITUDE, "joint": ANGLES_JOINT}
 FOLLOW_MODES = {"lock": FOLLOW_LOCK, "yaw": FOLLOW_YAW, "fpv": FOLLOW_FPV}
 ORIENTATIONS = {"keep": 0x00, "landscape": 0x01, "landscape-flipped": 0x02, "portrait": 0x03,
@@ -96,7 +91,7 @@ def position_message(yaw: float = 0.0, roll: float = 0.0, pitch: float = 0.0, *,
     for axis, value in zip(AXES, (yaw, roll, pitch)):
         raw[axis] = to_raw(value, f"{axis} angle") if axis in moving else 0
         if axis not in moving:
-            ctrl |= _AXIS_INVALID[axis]
+            ctrl |= POSITION_INVALID[axis]
     return PositionControl(raw["yaw"], raw["roll"], raw["pitch"], ctrl, to_raw(time_s, "time"))
 
 

@@ -18,9 +18,14 @@ FOCUS_CALIBRATION = 0x02
 FOCUS_POSITION_QUERY = 0x15
 FOCUS_MOTOR = 0x00
 FOCUS_POSITION_RANGE = (0, 4095)
-FOCUS_CALIBRATION_COMMANDS = {0x00: "none", 0x01: "auto", 0x02: "manual", 0x04: "set_min",
-                              0x05: "set_max", 0x06: "stop"}
-FOCUS_CALIBRATION_STATES = {0x01: "not calibrated", 0x02: "calibrating", 0x03: "calibrated"}
+FOCUS_CAL_NONE, FOCUS_CAL_AUTO, FOCUS_CAL_MANUAL = 0x00, 0x01, 0x02
+FOCUS_CAL_SET_MIN, FOCUS_CAL_SET_MAX, FOCUS_CAL_STOP = 0x04, 0x05, 0x06
+FOCUS_CALIBRATION_COMMANDS = {FOCUS_CAL_NONE: "none", FOCUS_CAL_AUTO: "auto", FOCUS_CAL_MANUAL: "manual",
+                              FOCUS_CAL_SET_MIN: "set_min", FOCUS_CAL_SET_MAX: "set_max",
+                              FOCUS_CAL_STOP: "stop"}
+FOCUS_NOT_CALIBRATED, FOCUS_CALIBRATING, FOCUS_CALIBRATED = 0x01, 0x02, 0x03
+FOCUS_CALIBRATION_STATES = {FOCUS_NOT_CALIBRATED: "not calibrated", FOCUS_CALIBRATING: "calibrating",
+                            FOCUS_CALIBRATED: "calibrated"}
 
 
 @register

@@ -27,6 +27,11 @@ ANGLES_NONE = 0x00
 ANGLES_ATTITUDE = 0x01
 ANGLES_JOINT = 0x02
 
+AXES = ("yaw", "roll", "pitch")  # the axis order of position, speed and angle messages
+ANGLE_RANGES = {"yaw": YAW_ANGLE_RANGE, "roll": ROLL_ANGLE_RANGE, "pitch": PITCH_ANGLE_RANGE}
+POSITION_INVALID = {"yaw": POSITION_YAW_INVALID, "roll": POSITION_ROLL_INVALID,
+                    "pitch": POSITION_PITCH_INVALID}  # ctrl_byte bit that leaves the axis alone
+
 
 def to_raw(value: float, name: str) -> int:
     """Degrees (or °/s, or s) to the wire's 0.1 units, rounded to the nearest unit."""

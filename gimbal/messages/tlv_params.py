@@ -17,7 +17,9 @@ ROLL360_MODES = {0: "three_axis", 1: "two_axis", 2: "roll360", 3: "3d_roll360"}
 
 AUTOTUNE = 0x00  # calibration TLV: bit 0 start/stop, bits 7..1 type (0 default, 1 single pose)
 AUTOTUNE_TYPES = {0: "default", 1: "single_pose"}
-CALIBRATION_STATES = {0: "idle", 1: "running", 2: "done", 3: "error"}
+CALIBRATION_IDLE, CALIBRATION_RUNNING, CALIBRATION_DONE, CALIBRATION_ERROR = 0, 1, 2, 3
+CALIBRATION_STATES = {CALIBRATION_IDLE: "idle", CALIBRATION_RUNNING: "running", CALIBRATION_DONE: "done",
+                      CALIBRATION_ERROR: "error"}
 CALIBRATION_STATUS_LENGTH = 6
 
 

@@ -1,13 +1,10 @@
 """The focus motor (0x0E/0x12): position control, calibration state machine and read-out."""
 from __future__ import annotations
 
-from gimbal.messages.external import FOCUS_POSITION_RANGE
-
-NOT_CALIBRATED = 0x01
-CALIBRATING = 0x02
-CALIBRATED = 0x03
-
-CAL_NONE, CAL_AUTO, CAL_MANUAL, CAL_SET_MIN, CAL_SET_MAX, CAL_STOP = 0x00, 0x01, 0x02, 0x04, 0x05, 0x06
+from gimbal.messages.external import (FOCUS_CAL_AUTO, FOCUS_CAL_MANUAL, FOCUS_CAL_NONE,
+                                      FOCUS_CAL_SET_MAX, FOCUS_CAL_SET_MIN, FOCUS_CAL_STOP,
+                                      FOCUS_CALIBRATED, FOCUS_CALIBRATING, FOCUS_NOT_CALIBRATED,
+                                      FOCUS_POSITION_RANGE)
 
 
 class FocusMotor:
@@ -19,7 +16,7 @@ class FocusMotor:
         self.calibration_s = calibration_s
         self.position = 0.0
         self.target = 0.0
-        self.state = NOT_CALIBRATED
+        self.state = FOCUS_NOT_CALIBRATED
         self.travel = (float(FOCUS_POSITION_RANGE[0]), float(FOCUS_POSITION_RANGE[1]))
         self.marks: dict[str, float] = {}  # manual calibration points
         self._calibration_done_at = 0.0
@@ -38,34 +35,34 @@ class FocusMotor:
 
     def calibrate(self, command: int, now: float) -> bool:
         """Run one calibration command; False when it cannot be carried out."""
-        if command == CAL_NONE:
+        if command == FOCUS_CAL_NONE:
             return True
-        if command == CAL_AUTO:
-            self.state = CALIBRATING
+        if command == FOCUS_CAL_AUTO:
+            self.state = FOCUS_CALIBRATING
             self._calibration_done_at = now + self.calibration_s
             return True
-        if command in (CAL_SET_MIN, CAL_SET_MAX):
-            self.marks["min" if command == CAL_SET_MIN else "max"] = self.position
+        if command in (FOCUS_CAL_SET_MIN, FOCUS_CAL_SET_MAX):
+            self.marks["min" if command == FOCUS_CAL_SET_MIN else "max"] = self.position
             return True
-        if command == CAL_MANUAL:
+        if command == FOCUS_CAL_MANUAL:
             low, high = self.marks.get("min"), self.marks.get("max")
             if low is None or high is None or low >= high:
                 return False
-            self.travel, self.state = (low, high), CALIBRATED
+            self.travel, self.state = (low, high), FOCUS_CALIBRATED
             self.target = self._clamp(self.target)
             return True
-        if command == CAL_STOP:
-            if self.state != CALIBRATING:
+        if command == FOCUS_CAL_STOP:
+            if self.state != FOCUS_CALIBRATING:
                 return False
-            self.state = NOT_CALIBRATED
+            self.state = FOCUS_NOT_CALIBRATED
             return True
         return False
 
     def advance(self, now: float) -> None:
         dt = 0.0 if self._last is None else max(0.0, now - self._last)
         self._last = now
-        if self.state == CALIBRATING and now >= self._calibration_done_at:
-            self.state = CALIBRATED
+        if self.state == FOCUS_CALIBRATING and now >= self._calibration_done_at:
+            self.state = FOCUS_CALIBRATED
             self.travel = (float(FOCUS_POSITION_RANGE[0]), float(FOCUS_POSITION_RANGE[1]))
         if self._dial and now < self._dial_until:
             self.target = self._clamp(self.position + self._dial * dt)

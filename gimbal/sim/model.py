@@ -9,19 +9,18 @@ from typing import Any
 from gimbal.errors import ReturnCode
 from gimbal.messages import Message, Reply, Tlv
 from gimbal.messages import camera, external, motion, settings, telemetry, tlv_params
+from gimbal.messages.motion import AXES
+from gimbal.messages.tlv_params import CALIBRATION_DONE, CALIBRATION_IDLE, CALIBRATION_RUNNING
 from gimbal.sim.config import SimConfig
 from gimbal.sim.dynamics import Axis, AxisMode, AxisRange, wrap180
 from gimbal.sim.focus import FocusMotor
 from gimbal.sim.state import SimState
 
-AXES = ("yaw", "roll", "pitch")
-MECHANICAL = {"yaw": (-180.0, 180.0), "roll": (-30.0, 30.0), "pitch": (-56.0, 146.0)}
-POSITION_INVALID_BITS = {"yaw": motion.POSITION_YAW_INVALID, "roll": motion.POSITION_ROLL_INVALID,
-                         "pitch": motion.POSITION_PITCH_INVALID}
+MECHANICAL = {axis: (motion.from_raw(low), motion.from_raw(high))
+              for axis, (low, high) in motion.ANGLE_RANGES.items()}  # degrees
 ORIENTATIONS = {0x01: 0, 0x02: 180, 0x03: 90, 0x04: -90, 0xFF: 0}
 OK = int(ReturnCode.OK)
 FAILED = int(ReturnCode.EXECUTION_FAILED)
-CAL_IDLE, CAL_RUNNING, CAL_DONE = 0, 1, 2
 JOYSTICK_FULL_SCALE = external.JOYSTICK_RANGE[1]
 DIAL_FULL_SCALE = external.DIAL_RANGE[1]
 
@@ -45,7 +44,7 @@ class GimbalModel:
         self.param_table = 0
         self.roll360_mode = 0
         self.push_enabled = False
-        self.calibration = (CAL_IDLE, 0)
+        self.calibration = (CALIBRATION_IDLE, 0)
         self.focus = FocusMotor(config.focus_speed, config.focus_calibration_s)
         self.recording = False
         self.photos = 0
@@ -102,7 +101,7 @@ class GimbalModel:
         """Why motion commands fail now, if they do."""
         if self.motors_off:
             return "motors off"
-        if self.calibration[0] == CAL_RUNNING:
+        if self.calibration[0] == CALIBRATION_RUNNING:
             return "auto-calibration running"
         return None
 
@@ -135,13 +134,14 @@ class GimbalModel:
             axis.advance(now, self.axis_range(name))
         self.focus.advance(now)
         pushes: list[Message] = []
-        if self.calibration[0] == CAL_RUNNING:
+        if self.calibration[0] == CALIBRATION_RUNNING:
             elapsed = now - self._calibration_started
             if elapsed >= self.config.calibration_s:
-                self.calibration = (CAL_DONE, 100)
-                pushes.append(tlv_params.CalibrationStatusPush.of(CAL_DONE, 100))
+                self.calibration = (CALIBRATION_DONE, 100)
+                pushes.append(tlv_params.CalibrationStatusPush.of(CALIBRATION_DONE, 100))
             else:
-                self.calibration = (CAL_RUNNING, min(99, int(100 * elapsed / self.config.calibration_s)))
+                progress = min(99, int(100 * elapsed / self.config.calibration_s))
+                self.calibration = (CALIBRATION_RUNNING, progress)
                 if now >= self._next_calibration_push:
                     pushes.append(tlv_params.CalibrationStatusPush.of(*self.calibration))
                     self._next_calibration_push += 1.0 / self.config.calibration_push_hz
@@ -169,7 +169,7 @@ class GimbalModel:
         values = {"yaw": msg.yaw_angle, "roll": msg.roll_angle, "pitch": msg.pitch_angle}
         targets = {}
         for name, raw in values.items():
-            if msg.ctrl_byte & POSITION_INVALID_BITS[name]:
+            if msg.ctrl_byte & motion.POSITION_INVALID[name]:
                 continue
             target = motion.from_raw(raw) if absolute else self.axes[name].angle + motion.from_raw(raw)
             if not self.axis_range(name).contains(target):
@@ -300,17 +300,17 @@ class GimbalModel:
         return msg.REPLY(OK)
 
     def _auto_calibration(self, msg: tlv_params.AutoCalibration, now: float) -> Reply:
-        running = self.calibration[0] == CAL_RUNNING
+        running = self.calibration[0] == CALIBRATION_RUNNING
         if not msg.start:
             if running:
-                self.calibration = (CAL_IDLE, 0)
+                self.calibration = (CALIBRATION_IDLE, 0)
             return msg.REPLY(OK)
         if running or self.motors_off:
             return msg.REPLY(FAILED)
         for axis in self.axes.values():
             axis.halt()
         self.speed_control = False
-        self.calibration = (CAL_RUNNING, 0)
+        self.calibration = (CALIBRATION_RUNNING, 0)
         self._calibration_started = self._next_calibration_push = now
         return msg.REPLY(OK)
 

@@ -15,15 +15,15 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from gimbal.client import (FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, FIRST_SEQ, GimbalClient,
-                           exit_on_signals, lookup, position_message, speed_message)
+from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, FIRST_SEQ,
+                           GimbalClient, exit_on_signals, lookup, position_message, speed_message)
 from gimbal.errors import GimbalError, GimbalTimeoutError, RangeError
 from gimbal.messages import Message, message_packet
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
-from gimbal.messages.external import (DialPush, FocusCalibration, FocusPositionControl,
-                                      FocusPositionQuery, JoystickPush)
-from gimbal.messages.motion import ANGLES_ATTITUDE, ANGLES_JOINT, GetAngles, from_raw
-from gimbal.messages.settings import (ActiveTrack, GetAngleLimits, GetMotorStiffness,
+from gimbal.messages.external import (FOCUS_CALIBRATION_STATES, DialPush, FocusCalibration,
+                                      FocusPositionControl, FocusPositionQuery, JoystickPush)
+from gimbal.messages.motion import ANGLE_RANGES, AXES, GetAngles, from_raw
+from gimbal.messages.settings import (LIMIT_RANGES, ActiveTrack, GetAngleLimits, GetMotorStiffness,
                                       RecenterSelfie, SetAngleLimits, SetFollowMode,
                                       SetMotorStiffness, SetWorkMode, SELFIE)
 from gimbal.messages.telemetry import (PUSH_DISABLE, PUSH_ENABLE, ParameterPush, PushControl,
@@ -36,7 +36,7 @@ from pipelines.cli.bus import open_host_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, suppress_defaults
 
 Result = dict[str, Any]
-LIMITS = ("pitch_max", "pitch_min", "yaw_max", "yaw_min", "roll_max", "roll_min")
+LIMITS = tuple(LIMIT_RANGES)
 STIFFNESS = ("pitch", "roll", "yaw")
 CAMERA_ACTIONS = {code.name.lower().replace("_", "-"): code for code in CameraActionCode}
 OK: Result = {"ok": True}
@@ -101,8 +101,8 @@ def describe_push(message: Message, t: float) -> Result:
     out: Result = {"t": round(t, 4), "push": message.NAME}
     if isinstance(message, ParameterPush):
         if message.angles_valid:
-            out["attitude"] = {a: _deg(getattr(message, f"{a}_angle")) for a in ("yaw", "roll", "pitch")}
-            out["joint"] = {a: _deg(getattr(message, f"{a}_joint_angle")) for a in ("yaw", "roll", "pitch")}
+            out["attitude"] = {a: _deg(getattr(message, f"{a}_angle")) for a in AXES}
+            out["joint"] = {a: _deg(getattr(message, f"{a}_joint_angle")) for a in AXES}
         if message.limits_valid:
             out["limits"] = {n: getattr(message, n) for n in LIMITS}
         if message.stiffness_valid:
@@ -140,13 +140,13 @@ def _angles_args(p: argparse.ArgumentParser) -> None:
 
 
 def _angles_messages(args: argparse.Namespace) -> list[Message]:
-    codes = {"attitude": ANGLES_ATTITUDE, "joint": ANGLES_JOINT}
-    return [GetAngles(codes[k]) for k in _kinds(args)]
+    return [GetAngles(ANGLE_KINDS[k]) for k in _kinds(args)]
 
 
 def _move_args(p: argparse.ArgumentParser) -> None:
-    for axis, span in (("yaw", "-180..180"), ("roll", "-30..30"), ("pitch", "-56..146")):
-        p.add_argument(f"--{axis}", type=float, help=f"{axis} in degrees ({span}); omitted axes stay")
+    for axis, (low, high) in ANGLE_RANGES.items():
+        p.add_argument(f"--{axis}", type=float,
+                       help=f"{axis} in degrees ({from_raw(low):g}..{from_raw(high):g}); omitted axes stay")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--absolute", dest="absolute", action="store_true", default=True,
                       help="angles are absolute (default)")
@@ -155,7 +155,7 @@ def _move_args(p: argparse.ArgumentParser) -> None:
 
 
 def _move_message(args: argparse.Namespace) -> list[Message]:
-    axes = [a for a in ("yaw", "roll", "pitch") if getattr(args, a) is not None]
+    axes = [a for a in AXES if getattr(args, a) is not None]
     if not axes:
         raise CliError("give at least one of --yaw, --roll, --pitch")
     return [position_message(args.yaw or 0.0, args.roll or 0.0, args.pitch or 0.0,
@@ -163,7 +163,7 @@ def _move_message(args: argparse.Namespace) -> list[Message]:
 
 
 def _move(client: GimbalClient, args: argparse.Namespace) -> Result:
-    axes = [a for a in ("yaw", "roll", "pitch") if getattr(args, a) is not None]
+    axes = [a for a in AXES if getattr(args, a) is not None]
     client.position(args.yaw or 0.0, args.roll or 0.0, args.pitch or 0.0,
                     absolute=args.absolute, time_s=args.time, axes=axes)
     return {"moving": {a: getattr(args, a) for a in axes}, "absolute": args.absolute,
@@ -197,9 +197,9 @@ def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:
 
 def _limits_args(p: argparse.ArgumentParser) -> None:
     for name in LIMITS:
-        top = {"pitch_max": 145, "pitch_min": 55, "yaw_max": 179, "yaw_min": 179}.get(name, 30)
         p.add_argument("--" + name.replace("_", "-"), type=int, dest=name,
-                       help=f"whole degrees 0..{top}" + (" (below zero)" if name.endswith("min") else ""))
+                       help=f"whole degrees 0..{LIMIT_RANGES[name][1]}"
+                       + (" (below zero)" if name.endswith("min") else ""))
 
 
 def _limits_messages(args: argparse.Namespace) -> list[Message]:
@@ -366,8 +366,8 @@ def _focus(client: GimbalClient, args: argparse.Namespace) -> Result:
     if isinstance(message, FocusCalibration):
         return {"calibration": args.value, "succeeded": client.focus_calibration(args.value)}
     reply = client.focus_read()
-    return {"calibration_state": {1: "not calibrated", 2: "calibrating", 3: "calibrated"}.get(
-        reply.calibration_state, reply.calibration_state), "position": reply.position}
+    return {"calibration_state": FOCUS_CALIBRATION_STATES.get(reply.calibration_state, reply.calibration_state),
+            "position": reply.position}
 
 
 def _joystick_args(p: argparse.ArgumentParser) -> None:
