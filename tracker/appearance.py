@@ -27,17 +27,16 @@ class AppearanceModel:
     """
 
     def __init__(self, frame: np.ndarray, box: Box) -> None:
-        self.anchor = _patch(frame, box)
+        self.anchor = cut_patch(frame, box)
         self.recent = self.anchor.copy()
 
-    def similarity(self, frame: np.ndarray, box: Box) -> float:
-        """How much the patch under ``box`` looks like the subject, 0..1."""
-        patch = _patch(frame, box)
+    def similarity(self, patch: np.ndarray) -> float:
+        """How much ``patch`` (from :func:`cut_patch`) looks like the subject, 0..1."""
         return max(_ncc(patch, self.anchor), _ncc(patch, self.recent))
 
-    def adapt(self, frame: np.ndarray, box: Box, rate: float) -> None:
-        """Blend the patch under ``box`` into the adaptive template."""
-        cv2.addWeighted(self.recent, 1.0 - rate, _patch(frame, box), rate, 0.0, dst=self.recent)
+    def adapt(self, patch: np.ndarray, rate: float) -> None:
+        """Blend ``patch`` (from :func:`cut_patch`) into the adaptive template."""
+        cv2.addWeighted(self.recent, 1.0 - rate, patch, rate, 0.0, dst=self.recent)
 
     def search(self, frame: np.ndarray, around: Box, size: tuple[float, float], reach: float) -> Match:
         """Best match for a ``size`` box within ``reach`` box sizes of ``around``'s centre."""
@@ -66,7 +65,8 @@ def _grey(image: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
 
 
-def _patch(frame: np.ndarray, box: Box) -> np.ndarray:
+def cut_patch(frame: np.ndarray, box: Box) -> np.ndarray:
+    """The grey template-sized patch under ``box``, as the model compares and learns it."""
     x, y, w, h = box
     w, h = max(w, 2.0), max(h, 2.0)
     crop = cv2.getRectSubPix(frame, (int(round(w)), int(round(h))), (x + w / 2.0, y + h / 2.0))

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tracker.appearance import AppearanceModel, Match
+from tracker.appearance import AppearanceModel, Match, cut_patch
 from tracker.backends import TrackingBackend
 from tracker.boxes import Box, clip_to_frame
 from tracker.detectors import Detector
@@ -69,10 +69,11 @@ class SubjectTracker:
         s = self.settings
         predicted = self._kalman.predict(timestamp)
         box, backend_score = self._backend.update(frame)
-        similarity = self._appearance.similarity(frame, box) if box is not None else 0.0
+        patch = cut_patch(frame, box) if box is not None else None
+        similarity = self._appearance.similarity(patch) if patch is not None else 0.0
         confidence = backend_score * similarity
         if box is not None and confidence >= s.track_confidence:
-            return self._accept(frame, box, confidence, timestamp)
+            return self._accept(frame, box, patch, confidence, timestamp)
         self._misses += 1
         found = self._search(frame, predicted) if self._misses >= s.reacquire_after_frames else Match(predicted, 0.0)
         if found.score >= s.reacquire_score and found.score >= similarity + s.reacquire_margin:
@@ -85,12 +86,13 @@ class SubjectTracker:
             self._kalman.correct(box, confidence)
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
-    def _accept(self, frame: np.ndarray, box: Box, confidence: float, timestamp: float) -> TargetEstimate:
+    def _accept(self, frame: np.ndarray, box: Box, patch: np.ndarray, confidence: float,
+                timestamp: float) -> TargetEstimate:
         s = self.settings
         self._misses = 0
         self._size = (box[2], box[3])
         if confidence >= s.adapt_confidence:
-            self._appearance.adapt(frame, box, s.adapt_rate)
+            self._appearance.adapt(patch, s.adapt_rate)  # the patch the similarity was measured on
         if s.refine_blend > 0:
             box = self._refine(frame, box)
         self._kalman.correct(box, confidence)
@@ -117,7 +119,7 @@ class SubjectTracker:
         best = self._appearance.search(frame, predicted, self._size, reach)
         if self._detector is not None and self._misses > s.lost_after_frames:
             for detection in self._detector.detect(frame):
-                score = self._appearance.similarity(frame, detection.box)
+                score = self._appearance.similarity(cut_patch(frame, detection.box))
                 if score > best.score:
                     best = Match(detection.box, score)
         return best
