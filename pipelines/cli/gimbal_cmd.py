@@ -208,15 +208,23 @@ def _limits_messages(args: argparse.Namespace) -> list[Message]:
     return [SetAngleLimits(1, **given)] if given else [GetAngleLimits()]
 
 
-def _limits(client: GimbalClient, args: argparse.Namespace) -> Result:
-    given = _given(args, LIMITS)
+def _read_or_update(args: argparse.Namespace, names: tuple[str, ...], field: str,
+                    read: Callable[[], Message], write: Callable[..., None]) -> dict[str, int]:
+    """All values read; or the given ones written, the others first read back and kept.
+    ``field`` turns a name into the reply's field name."""
+    given = _given(args, names)
     if given:
-        current = client.get_angle_limits() if len(given) < len(LIMITS) else None
-        values = {n: given.get(n, getattr(current, n, None)) for n in LIMITS}
-        client.set_angle_limits(**values)
-        return {"limits": values}
-    reply = client.get_angle_limits()
-    return {"limits": {n: getattr(reply, n) for n in LIMITS}}
+        current = read() if len(given) < len(names) else None
+        values = {n: given.get(n, getattr(current, field.format(n), None)) for n in names}
+        write(**values)
+        return values
+    reply = read()
+    return {n: getattr(reply, field.format(n)) for n in names}
+
+
+def _limits(client: GimbalClient, args: argparse.Namespace) -> Result:
+    return {"limits": _read_or_update(args, LIMITS, "{}", client.get_angle_limits,
+                                      client.set_angle_limits)}
 
 
 def _stiffness_args(p: argparse.ArgumentParser) -> None:
@@ -233,14 +241,8 @@ def _stiffness_messages(args: argparse.Namespace) -> list[Message]:
 
 
 def _stiffness(client: GimbalClient, args: argparse.Namespace) -> Result:
-    given = _given(args, STIFFNESS)
-    if given:
-        current = client.get_stiffness() if len(given) < len(STIFFNESS) else None
-        values = {a: given.get(a, getattr(current, f"{a}_stiffness", None)) for a in STIFFNESS}
-        client.set_stiffness(**values)
-        return {"stiffness": values}
-    reply = client.get_stiffness()
-    return {"stiffness": {a: getattr(reply, f"{a}_stiffness") for a in STIFFNESS}}
+    return {"stiffness": _read_or_update(args, STIFFNESS, "{}_stiffness", client.get_stiffness,
+                                         client.set_stiffness)}
 
 
 def _watch_args(p: argparse.ArgumentParser) -> None:
