@@ -51,7 +51,7 @@ class AppearanceModel:
         crop = frame[ry:ry + rh, rx:rx + rw]
         scaled = cv2.resize(crop, (max(TEMPLATE_PX, int(round(rw * sx))), max(TEMPLATE_PX, int(round(rh * sy)))),
                             interpolation=cv2.INTER_AREA)
-        grey = _grey(scaled).astype(np.float32)
+        grey = to_grey(scaled).astype(np.float32)
         best = Match(around, 0.0)
         for template in (self.anchor, self.recent):
             scores = cv2.matchTemplate(grey, template, cv2.TM_CCOEFF_NORMED)
@@ -61,7 +61,8 @@ class AppearanceModel:
         return best
 
 
-def _grey(image: np.ndarray) -> np.ndarray:
+def to_grey(image: np.ndarray) -> np.ndarray:
+    """A BGR image in grey (a grey image as it is)."""
     return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
 
 
@@ -70,7 +71,7 @@ def cut_patch(frame: np.ndarray, box: Box) -> np.ndarray:
     x, y, w, h = box
     w, h = max(w, 2.0), max(h, 2.0)
     crop = cv2.getRectSubPix(frame, (int(round(w)), int(round(h))), (x + w / 2.0, y + h / 2.0))
-    return _grey(cv2.resize(crop, (TEMPLATE_PX, TEMPLATE_PX), interpolation=cv2.INTER_AREA)).astype(np.float32)
+    return to_grey(cv2.resize(crop, (TEMPLATE_PX, TEMPLATE_PX), interpolation=cv2.INTER_AREA)).astype(np.float32)
 
 
 def _ncc(a: np.ndarray, b: np.ndarray) -> float:

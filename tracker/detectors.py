@@ -1,6 +1,7 @@
 """Detectors that find a subject to start on: faces, people and the largest moving thing."""
 from __future__ import annotations
 
+import functools
 from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
@@ -9,6 +10,7 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from tracker.appearance import to_grey
 from tracker.boxes import Box
 from tracker.model_files import find_model_file
 
@@ -44,7 +46,7 @@ class HaarFaceDetector:
             raise ValueError(f"cannot load Haar cascade {path}")
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
-        grey = cv2.equalizeHist(cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame)
+        grey = cv2.equalizeHist(to_grey(frame))
         boxes, hits = self._cascade.detectMultiScale2(grey, scaleFactor=1.1, minNeighbors=4, minSize=(20, 20))
         found = [Detection(tuple(float(v) for v in b), float(1.0 - np.exp(-n / 8.0))) for b, n in zip(boxes, hits)]
         return sorted(found, key=lambda d: d.score, reverse=True)
@@ -98,7 +100,7 @@ class MotionDetector:
         self._history: deque[np.ndarray] = deque(maxlen=3)
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
-        grey = cv2.GaussianBlur(cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame, (5, 5), 0)
+        grey = cv2.GaussianBlur(to_grey(frame), (5, 5), 0)
         self._history.append(grey)
         if len(self._history) < 3:
             return []
@@ -107,9 +109,7 @@ class MotionDetector:
     def _moving_mask(self, older: np.ndarray, previous: np.ndarray, current: np.ndarray) -> np.ndarray:
         mask = (cv2.absdiff(current, previous) > self._threshold) & (cv2.absdiff(current, older) > self._threshold)
         mask = mask.astype(np.uint8) * 255
-        k = max(3, int(round(max(mask.shape) / 80)) | 1)
-        kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
-        return cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel, iterations=2)
+        return cv2.morphologyEx(mask, cv2.MORPH_CLOSE, _closing_kernel(mask.shape), iterations=2)
 
     def _blobs(self, mask: np.ndarray) -> list[Detection]:
         count, _, stats, _ = cv2.connectedComponentsWithStats(mask)
@@ -118,6 +118,13 @@ class MotionDetector:
         found = [Detection(tuple(float(v) for v in stats[i, :4]), float(stats[i, cv2.CC_STAT_AREA] / total))
                  for i in range(1, count) if stats[i, cv2.CC_STAT_AREA] >= self._min_area_fraction * frame_area]
         return sorted(found, key=lambda d: d.box[2] * d.box[3], reverse=True)
+
+
+@functools.lru_cache(maxsize=8)
+def _closing_kernel(shape: tuple[int, ...]) -> np.ndarray:
+    """The ellipse that closes gaps in a moving-pixel mask of ``shape`` (about 1/80 of its longer side)."""
+    k = max(3, int(round(max(shape) / 80)) | 1)
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
 
 
 def make_detector(kind: str, model_dir: str | Path | None = None) -> Detector:
