@@ -19,7 +19,7 @@ from gimbal.sim.config import SimConfig
 from gimbal.sim.faults import FaultInjector, Faults
 from gimbal.sim.model import GimbalModel
 from gimbal.sim.state import SimState
-from gimbal.transport import packet_frames
+from gimbal.transport import CAN_FRAME_DATA, bus_send_lock
 
 log = logging.getLogger(__name__)
 
@@ -43,7 +43,7 @@ class SimulatedGimbal:
         self._framer = PacketFramer()
         self._model = GimbalModel(config, clock())
         self._lock = threading.Lock()  # model, framer, counters, delayed replies
-        self._send_lock = threading.Lock()  # the frames of one packet never interleave
+        self._send_lock = bus_send_lock(bus)  # shared by all senders on bus: packets never interleave
         self._sent: Counter[str] = Counter()
         self._discarded: Counter[str] = Counter()
         self._delayed: list[tuple[float, int, Packet, str]] = []
@@ -162,11 +162,10 @@ class SimulatedGimbal:
         if self._injector.silent(now - self._started_at):
             self._discarded["silent_tx"] += 1
             return
-        frames = []
-        for frame in packet_frames(encode_packet(packet), self.config.tx_id):
-            data = self._injector.frame(bytes(frame.data), "tx")
-            if data is not None:
-                frames.append(can.Message(arbitration_id=self.config.tx_id, is_extended_id=False, data=data))
+        raw = encode_packet(packet)
+        frames = [can.Message(arbitration_id=self.config.tx_id, is_extended_id=False, data=data)
+                  for i in range(0, len(raw), CAN_FRAME_DATA)
+                  if (data := self._injector.frame(raw[i:i + CAN_FRAME_DATA], "tx")) is not None]
         self._sent[name] += 1
         self._bus_send(frames)
 
