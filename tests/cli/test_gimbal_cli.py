@@ -7,7 +7,6 @@ import json
 import random
 import signal
 import subprocess
-import sys
 from pathlib import Path
 
 import can
@@ -19,6 +18,7 @@ from gimbal.messages.settings import AngleLimitsReply, GetAngleLimits, SetAngleL
 from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv
 from pipelines.cli import main
 from tests.gimbal.scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages
+from tests.support import cli_command
 
 DOC_EXAMPLE = "AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE"
 
@@ -169,9 +169,8 @@ def test_sigterm_to_a_streaming_process_stops_and_releases() -> None:
     bus = can.Bus(interface="udp_multicast", channel=group)
     with ScriptedPeer(bus) as peer:
         peer.answer(SpeedControl)
-        child = subprocess.Popen([sys.executable, "-c", "import sys; from pipelines.cli import main; "
-                                  "sys.exit(main(sys.argv[1:]))", "gimbal", "speed", "--yaw", "15",
-                                  "--duration", "60", "-i", "udp_multicast", "-c", group],
+        child = subprocess.Popen(cli_command("gimbal", "speed", "--yaw", "15", "--duration", "60",
+                                             "-i", "udp_multicast", "-c", group),
                                  stderr=subprocess.PIPE, text=True)
         try:
             peer.wait_for(SpeedControl, 3, timeout=20.0, where=lambda m: m.yaw_speed == 150)

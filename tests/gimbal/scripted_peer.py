@@ -16,6 +16,7 @@ from gimbal.messages import Message, decode_message, message_packet
 from gimbal.messages.motion import SpeedControl
 from gimbal.packet import Packet
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport
+from tests.support import wait_until
 
 ReplyFactory = Callable[[Message], Message | None]
 
@@ -150,10 +151,7 @@ class ScriptedPeer:
 
 def poll(condition: Callable[[], bool], timeout: float = 5.0) -> None:
     """Wait for something the other threads do; fail after a generous timeout."""
-    deadline = time.monotonic() + timeout
-    while not condition():
-        assert time.monotonic() < deadline, "condition not reached"
-        time.sleep(0.005)
+    assert wait_until(condition, timeout, step=0.005), "condition not reached"
 
 
 class FlakyBus(VirtualBus):

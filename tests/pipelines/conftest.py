@@ -11,6 +11,8 @@ import cv2
 import numpy as np
 import pytest
 
+from tests.support import write_clip
+
 
 def _frame_image(index: int, size: tuple[int, int] = (96, 64)) -> np.ndarray:
     """A frame whose mean brightness encodes ``index`` (step 10) with a moving square for texture."""
@@ -22,12 +24,7 @@ def _frame_image(index: int, size: tuple[int, int] = (96, 64)) -> np.ndarray:
 
 
 def _write_video(path: Path, frames: int, fps: float = 25.0, size: tuple[int, int] = (96, 64)) -> Path:
-    writer = cv2.VideoWriter(str(path), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*"mp4v"), fps, size)
-    assert writer.isOpened()
-    for index in range(frames):
-        writer.write(_frame_image(index, size))
-    writer.release()
-    return path
+    return write_clip(path, (_frame_image(index, size) for index in range(frames)), fps, "mp4v")
 
 
 @pytest.fixture

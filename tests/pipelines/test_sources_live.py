@@ -4,7 +4,6 @@ from __future__ import annotations
 import itertools
 import os
 import shutil
-import socket
 import subprocess
 import threading
 from collections.abc import Callable
@@ -15,6 +14,7 @@ import pytest
 
 from pipelines.sources import SourceError, open_source
 from pipelines.sources.live import LatestFrameGrabber, LiveSource
+from tests.support import free_udp_port
 
 WAIT = 10.0  # generous bound for thread hand-offs; tests never assert on durations
 
@@ -119,12 +119,6 @@ def test_camera_that_does_not_open() -> None:
         open_source("97")
 
 
-def _free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
 @pytest.fixture
 def ffmpeg() -> str:
     path = shutil.which("ffmpeg")
@@ -140,7 +134,7 @@ def ffmpeg() -> str:
 def test_udp_stream_is_read_live_and_stalls_when_the_sender_stops(
         ffmpeg: str, tmp_path: Path, write_video: Callable[..., Path]) -> None:
     clip = write_video(tmp_path / "clip.mp4", 150, fps=30.0, size=(160, 120))
-    url = f"udp://127.0.0.1:{_free_udp_port()}"
+    url = f"udp://127.0.0.1:{free_udp_port()}"
     sender = subprocess.Popen(
         [ffmpeg, "-hide_banner", "-loglevel", "error", "-re", "-i", str(clip), "-c:v", "mpeg2video",
          "-g", "10", "-q:v", "4", "-f", "mpegts", f"{url}?pkt_size=1316"],

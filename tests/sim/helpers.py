@@ -9,6 +9,9 @@ import can
 from gimbal.messages import Kind, Message, decode_message, message_packet
 from gimbal.packet import Packet
 from gimbal.transport import CanTransport
+from tests.support import wait_until
+
+__all__ = ["RawHost", "wait_until"]  # the sim tests import wait_until from here
 
 
 class RawHost:
@@ -58,11 +61,3 @@ class RawHost:
         if message.KIND is Kind.PUSH:
             self.pushes.append((message, time.monotonic()))
 
-
-def wait_until(predicate, timeout: float, step: float = 0.01) -> bool:  # type: ignore[no-untyped-def]
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(step)
-    return predicate()

@@ -6,7 +6,6 @@ import os
 import random
 import signal
 import subprocess
-import sys
 import time
 from collections.abc import Iterator
 
@@ -16,10 +15,10 @@ from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, ReturnCodeError
 from gimbal.messages.telemetry import ParameterPush
 from pipelines.cli import build_parser, main
+from tests.support import ROOT, cli_command
 
 # Non-default ids keep this test apart from anything else on the shared multicast port.
 IDS = ["--tx-id", "0x323", "--rx-id", "0x322"]
-CLI = [sys.executable, "-c", "import sys; from pipelines.cli import main; sys.exit(main())"]
 
 
 def group() -> str:
@@ -29,10 +28,9 @@ def group() -> str:
 @pytest.fixture
 def sim_process() -> Iterator[tuple[subprocess.Popen[str], str]]:
     channel = group()
-    proc = subprocess.Popen(CLI + ["sim", "-i", "udp_multicast", "-c", channel, *IDS,
-                                   "--status-interval", "0.2", "--push-rate", "40", "--version", "01.02.0A.0B"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=os.path.dirname(os.path.dirname(os.path.dirname(__file__))))
+    proc = subprocess.Popen(cli_command("sim", "-i", "udp_multicast", "-c", channel, *IDS,
+                                        "--status-interval", "0.2", "--push-rate", "40", "--version", "01.02.0A.0B"),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
     yield proc, channel
     if proc.poll() is None:
         proc.kill()
@@ -92,7 +90,7 @@ def test_gimbal_cli_drives_the_simulator_process(sim_process) -> None:
     bus = ["-i", "udp_multicast", "-c", channel, *IDS, "--timeout", "0.3"]
 
     def gimbal(*args: str) -> None:
-        done = subprocess.run(CLI + ["gimbal", *args, *bus], capture_output=True, text=True, timeout=30)
+        done = subprocess.run(cli_command("gimbal", *args, *bus), capture_output=True, text=True, timeout=30)
         assert done.returncode == 0, done.stderr
 
     with connect(channel) as client:

@@ -1,11 +1,7 @@
 """What the track tests share: synthetic clips, running the CLI, reading the recorded command stream."""
 from __future__ import annotations
 
-import json
-import os
-import socket
 import subprocess
-import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,8 +16,8 @@ from gimbal.log_decode import HOST_TO_GIMBAL, decode_frames
 from gimbal.transport import HOST_TX_ID
 from gimbal.messages.motion import SPEED_RANGE, SPEED_TAKE_CONTROL
 from pipelines.cli import main
+from tests.support import ROOT, cli_command, write_clip
 
-ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "samples" / "demo.mp4"
 DEMO_ROI = (ROOT / "samples" / "demo_roi.txt").read_text().strip()
 SIZE = (320, 240)
@@ -37,18 +33,17 @@ def make_clip(path: Path, frames: int, position: Position, fps: float = 30.0) ->
     background = cv2.GaussianBlur(rng.integers(60, 200, (height, width, 3), dtype=np.uint8), (5, 5), 0)
     tile = np.indices((BOX, BOX)).sum(axis=0) // 8 % 2
     subject = np.where(tile[..., None] == 1, (20, 40, 230), (240, 240, 30)).astype(np.uint8)
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), fps, SIZE)
-    assert writer.isOpened()
-    for i in range(frames):
+
+    def image(i: int) -> np.ndarray:
         image = background.copy()
         where = position(i)
         if where is not None:
             x, y = where  # the square may stand partly outside the frame
             visible = subject[:max(0, min(BOX, height - y)), :max(0, min(BOX, width - x))]
             image[y:y + visible.shape[0], x:x + visible.shape[1]] = visible
-        writer.write(image)
-    writer.release()
-    return path
+        return image
+
+    return write_clip(path, (image(i) for i in range(frames)), fps, "MJPG")
 
 
 def roi_at(position: Position) -> str:
@@ -61,28 +56,8 @@ def run_track(source: Path | str, out: Path, *extra: str) -> int:
     return main(["track", str(source), "--out", str(out), "--quiet", *extra])
 
 
-def cli_command(*args: str) -> list[str]:
-    """``gimbaltrack ARGS`` as a subprocess command line, whatever is installed."""
-    return [sys.executable, "-c", "import sys; from pipelines.cli import main; sys.exit(main())", *args]
-
-
 def track_command(source: Path | str, out: Path, *extra: str) -> list[str]:
     return cli_command("track", str(source), "--out", str(out), "--quiet", *extra)
-
-
-def subprocess_env(can_port: int | None = None) -> dict[str, str]:
-    """The environment for CLI subprocesses; ``can_port`` isolates udp_multicast traffic from
-    every other test on the machine (python-can reads ``CAN_CONFIG``)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONUNBUFFERED": "1"}
-    if can_port is not None:
-        env["CAN_CONFIG"] = json.dumps({"port": can_port})
-    return env
-
-
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 @dataclass(frozen=True)

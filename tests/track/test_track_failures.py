@@ -14,17 +14,15 @@ import gimbal.sim
 import pipelines.cli.bus
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
+from tests.support import cli_command, free_udp_port, subprocess_env, wait_until
 from tests.track.helpers import (
     DEMO,
     DEMO_ROI,
     assert_stopped_at_end,
-    cli_command,
     decoded,
-    free_udp_port,
     run_track,
     speed_commands,
     start,
-    subprocess_env,
     track_command,
 )
 
@@ -93,10 +91,7 @@ def test_a_bus_falling_silent_mid_run(tmp_path: Path, capsys: pytest.CaptureFixt
 
 
 def _wait_for(predicate, timeout: float, what: str) -> None:  # type: ignore[no-untyped-def]
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        assert time.monotonic() < deadline, f"timed out waiting for {what}"
-        time.sleep(0.05)
+    assert wait_until(predicate, timeout, step=0.05), f"timed out waiting for {what}"
 
 
 @pytest.mark.parametrize("signum, code, status", [

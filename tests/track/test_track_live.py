@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 
 from pipelines.outputs.telemetry import read_telemetry
-from tests.track.helpers import (DEMO, ROOT, assert_stopped_at_end, decoded, free_udp_port, run_track,
-                                 speed_commands)
+from tests.support import ROOT, free_udp_port
+from tests.track.helpers import DEMO, assert_stopped_at_end, decoded, run_track, speed_commands
 
 FRAMES = 90  # 3 s of the 30 fps stream
 

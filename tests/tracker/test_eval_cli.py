@@ -1,19 +1,18 @@
 """``gimbaltrack eval``: text and JSON output, and one-line errors."""
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import cv2
 import pytest
 
+from tests.support import cli_command
 from tracker.synthetic import render_sequence
 
 
 def gimbaltrack(argv: list[str]) -> subprocess.CompletedProcess:
     """The real command in a fresh interpreter (exit code, stdout and stderr as a user sees them)."""
-    code = "import sys; from pipelines.cli import main; sys.exit(main())"
-    return subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=120)
+    return subprocess.run(cli_command(*argv), capture_output=True, text=True, timeout=120)
 
 
 @pytest.fixture(scope="module")
