@@ -5,6 +5,7 @@ import bisect
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
+from operator import attrgetter
 from typing import TYPE_CHECKING
 
 from gimbal.messages.telemetry import FLAG_ANGLES_VALID, ParameterPush
@@ -86,7 +87,7 @@ class AttitudeHistory:
             a, b = s[-2], s[-1]
             t = min(t, b.timestamp + self.max_extrapolation)
         else:
-            i = bisect.bisect_right([x.timestamp for x in s], t)
+            i = bisect.bisect_right(s, t, key=attrgetter("timestamp"))
             a, b = s[i - 1], s[i]
         span = b.timestamp - a.timestamp
         if span <= 0.0:

@@ -124,15 +124,18 @@ class RateController:
         self._last = RateCommand(0.0, 0.0)
 
     def _integrate_sent(self, t0: float, t1: float) -> tuple[float, float]:
-        """Angle (yaw, pitch) swept by the setpoints sent between times t0 and t1."""
+        """Angle (yaw, pitch) swept by the setpoints sent between times t0 and t1 (each one holds
+        until the next; they are sent in time order, so the walk back stops at the one before t0)."""
         dyaw = dpitch = 0.0
-        items = list(self._sent)
-        for i, (t, yaw, pitch) in enumerate(items):
-            end = items[i + 1][0] if i + 1 < len(items) else t1
+        end = t1
+        for t, yaw, pitch in reversed(self._sent):
             span = min(end, t1) - max(t, t0)
             if span > 0:
                 dyaw += yaw * span
                 dpitch += pitch * span
+            if t <= t0:
+                break
+            end = t
         return dyaw, dpitch
 
     def _pointing(self, t: float) -> tuple[float, float]:
