@@ -29,7 +29,7 @@ import can
 
 from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError, ReturnCodeError
 from gimbal.framer import Dropped
-from gimbal.messages import (DEVICE_PUSHES, Message, Reply, decode_message, is_legacy_reply,
+from gimbal.messages import (Message, Reply, decode_message, is_device_push, is_legacy_reply,
                              message_packet)
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, FocusCalibration,
@@ -272,8 +272,7 @@ class GimbalClient:
             self.stop_and_release()
 
     def _dispatch(self, packet: Packet, t: float) -> None:
-        key = tuple(packet.data[:2])
-        if key in DEVICE_PUSHES:
+        if is_device_push(packet):
             try:
                 message = decode_message(packet)
             except GimbalError as exc:

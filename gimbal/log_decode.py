@@ -20,8 +20,7 @@ import can
 
 from gimbal.errors import PayloadError, RangeError, UnknownMessageError, describe_return_code
 from gimbal.framer import Dropped, PacketFramer
-from gimbal.messages import Kind, Message, decode_message, is_legacy_reply
-from gimbal.messages.base import DEVICE_PUSHES
+from gimbal.messages import Kind, Message, decode_message, is_device_push, is_legacy_reply
 from gimbal.packet import Packet, encode_packet
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 
@@ -46,8 +45,7 @@ class _Outstanding:
 def infer_direction(packet: Packet) -> str:
     """Direction of a packet seen without its CAN id: replies and the gimbal's own pushes come
     from the gimbal, everything else from the host."""
-    data = packet.data
-    if packet.is_reply or (len(data) >= 2 and (data[0], data[1]) in DEVICE_PUSHES):
+    if packet.is_reply or is_device_push(packet):
         return GIMBAL_TO_HOST
     return HOST_TO_GIMBAL
 
@@ -101,7 +99,7 @@ class LogDecoder:
         return self._packet_record(item, direction or infer_direction(item), timestamp)
 
     def _packet_record(self, packet: Packet, direction: str, timestamp: float | None) -> Record:
-        legacy = packet.is_reply and is_legacy_reply(packet)
+        legacy = is_legacy_reply(packet)
         record: Record = {"direction": direction, "timestamp": timestamp, "seq": packet.seq,
                           "cmd_type": packet.cmd_type, "is_reply": packet.is_reply,
                           "cmd_set": None if legacy else _byte(packet.data, 0),

@@ -31,6 +31,13 @@ def is_legacy_reply(packet: Packet) -> bool:
     return packet.is_reply and (not packet.data or packet.data[0] not in CMD_SETS)
 
 
+def is_device_push(packet: Packet) -> bool:
+    """Whether CmdSet/CmdID name a push the device sends, whatever the reply bit says (some
+    firmware sets it on pushes)."""
+    data = packet.data
+    return len(data) >= 2 and (data[0], data[1]) in DEVICE_PUSHES
+
+
 def decode_message(packet: Packet, request: type[Message] | Message | None = None) -> Message:
     """The typed message a packet carries.
 
@@ -41,7 +48,7 @@ def decode_message(packet: Packet, request: type[Message] | Message | None = Non
     data = packet.data
     key = (data[0], data[1]) if len(data) >= 2 else None
     pushes = DEVICE_PUSHES.get(key) if key is not None else None
-    if pushes is not None:
+    if pushes is not None:  # is_device_push(packet), with the candidates at hand
         return _pick(pushes, data[2:], f"push 0x{key[0]:02X}/0x{key[1]:02X}").decode_payload(data[2:])
     if packet.is_reply:
         return _decode_reply(packet, request)
@@ -82,4 +89,4 @@ def message_packet(message: Message, seq: int, cmd_type: int | None = None,
 
 __all__ = ["CAMERA_CMD_SET", "GIMBAL_CMD_SET", "Command", "DevicePush", "HostPush", "Kind", "Message",
            "PayloadError", "Reply", "ReturnCodeReply", "Sender", "Tlv", "UnknownMessageError",
-           "all_message_classes", "decode_message", "is_legacy_reply", "message_packet"]
+           "all_message_classes", "decode_message", "is_device_push", "is_legacy_reply", "message_packet"]
