@@ -78,9 +78,10 @@ class SpeedCommand:
 
 
 def decoded(can_log: Path) -> list[dict[str, Any]]:
-    """The log's packets; host frames that came back marked ``R`` (udp_multicast loops every sent
-    frame back to the sender) are the bus's echo of the ``T`` ones and are left out."""
-    frames = [f for f in can.LogReader(str(can_log)) if not (f.arbitration_id == HOST_TX_ID and f.is_rx)]
+    """Every packet in the log as recorded; LoggingBus leaves out the bus's echo of its own frames
+    (udp_multicast loops every sent frame back to the sender), so no host frame is marked ``R``."""
+    frames = list(can.LogReader(str(can_log)))
+    assert not any(f.arbitration_id == HOST_TX_ID and f.is_rx for f in frames), "echo of a host frame logged"
     return list(decode_frames(frames))
 
 
