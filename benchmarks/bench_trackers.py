@@ -20,7 +20,7 @@ from tracker.boxes import Box
 from tracker.data_paths import shared_data_dir, shared_sequences
 from tracker.datasets import load_sequence
 from tracker.estimate import TargetEstimate, TrackState
-from tracker.evaluation import SequenceResult, run_sequence
+from tracker.evaluation import SequenceResult, run_sequence, summarize
 from tracker.registry import make_tracker
 
 BASELINE = "opencv-csrt"
@@ -75,19 +75,17 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _print_table(results: dict[str, list[SequenceResult]], names: list[str]) -> None:
-    base = results[BASELINE]
-    base_auc, base_fps = np.mean([r.auc for r in base]), np.median([r.fps for r in base])
-    base_cpu = np.median([r.cpu_fps for r in base])
+    base = summarize(results[BASELINE])
     short = [n.split("_", 1)[-1][:8] for n in names]
     print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps "
           "| AUC / CSRT | fps / CSRT | median CPU fps | CPU fps / CSRT |")
     print("|---" * (len(names) + 8) + "|")
     for label, rows in results.items():
-        auc, fps = np.mean([r.auc for r in rows]), np.median([r.fps for r in rows])
-        cpu = np.median([r.cpu_fps for r in rows])
+        s = summarize(rows)
         cells = " | ".join(f"{r.auc:.2f}" for r in rows)
-        print(f"| {label} | {cells} | {auc:.3f} | {np.mean([r.prec20 for r in rows]):.3f} | {fps:.0f} "
-              f"| {auc / base_auc:.2f} | {fps / base_fps:.2f} | {cpu:.0f} | {cpu / base_cpu:.2f} |")
+        print(f"| {label} | {cells} | {s['auc']:.3f} | {s['prec20']:.3f} | {s['fps']:.0f} "
+              f"| {s['auc'] / base['auc']:.2f} | {s['fps'] / base['fps']:.2f} | {s['cpu_fps']:.0f} "
+              f"| {s['cpu_fps'] / base['cpu_fps']:.2f} |")
 
 
 if __name__ == "__main__":

@@ -71,10 +71,11 @@ def run_sequence(tracker: Trackable, sequence: Sequence,
 
 
 def summarize(results: list[SequenceResult]) -> dict[str, float]:
-    """Mean precision and AUC over sequences, median fps."""
+    """Mean precision and AUC over sequences, median fps (wall-clock and CPU time)."""
     if not results:
         raise ValueError("no results to summarise")
     return {"sequences": len(results),
             "prec20": round(float(np.mean([r.prec20 for r in results])), 4),
             "auc": round(float(np.mean([r.auc for r in results])), 4),
-            "fps": round(float(np.median([r.fps for r in results])), 1)}
+            "fps": round(float(np.median([r.fps for r in results])), 1),
+            "cpu_fps": round(float(np.median([r.cpu_fps for r in results])), 1)}
