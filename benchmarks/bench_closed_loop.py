@@ -18,6 +18,7 @@ detections so the figures isolate the control loop).
 """
 from __future__ import annotations
 
+import functools
 import math
 import sys
 from pathlib import Path
@@ -31,28 +32,34 @@ from pipelines.control.direction import DirectionFilter
 from pipelines.virtual_camera import VirtualCamera
 from tracker.boxes import center
 from tracker.data_paths import shared_sequences
-from tracker.datasets import load_sequence
+from tracker.datasets import Sequence, load_sequence
 
 LATENCIES_MS = (0, 100)
 CONTROLLERS = ("p", "pid")
 TARGET_RATIO, TARGET_OUT_OF_VIEW = 0.5, 0.02
 
 
+@functools.cache
+def _load(path: Path) -> tuple[Sequence, tuple[int, int] | None]:
+    """The sequence and its frame size (width, height), its first image read once per run."""
+    seq = load_sequence(path)
+    first = cv2.imread(str(seq.frame_paths[0])) if seq.frame_paths else None
+    return seq, None if first is None else (first.shape[1], first.shape[0])
+
+
 def wide_sequences() -> list[Path]:
     found = []
     for path in shared_sequences():
-        seq = load_sequence(path)
-        first = cv2.imread(str(seq.frame_paths[0])) if seq.frame_paths else None
-        if seq.groundtruth is not None and first is not None and first.shape[1] >= 1280:
+        seq, size = _load(path)
+        if seq.groundtruth is not None and size is not None and size[0] >= 1280:
             found.append(path)
     return found
 
 
 def _truth_angles(path: Path) -> tuple[np.ndarray, float]:
     """World (yaw, pitch) of the subject's centre per frame, and degrees -> diagonal fraction."""
-    seq = load_sequence(path)
-    first = cv2.imread(str(seq.frame_paths[0]))
-    vc = VirtualCamera((first.shape[1], first.shape[0]))
+    seq, size = _load(path)
+    vc = VirtualCamera(size)
     angles = np.array([vc.source.pixel_to_angles(*center(box)) for box in seq.groundtruth])
     return angles, math.radians(1.0) * vc.camera.focal_px / vc.camera.diagonal_px
 
