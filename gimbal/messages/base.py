@@ -85,9 +85,6 @@ class Message:
         """Whether ``payload`` is this message rather than a sibling on the same CmdSet/CmdID."""
         return True
 
-    def values(self) -> list[Any]:
-        return [getattr(self, f.name) for f in dataclasses.fields(self)]
-
     def validate(self) -> None:
         """Raise ``RangeError`` for any field outside the document's range."""
         layout = _layout(type(self))

@@ -87,14 +87,13 @@ class GimbalModel:
 
     def refuse(self, message: Message, code: int) -> Reply:
         """Count ``message`` but do not execute it: the reply carries ``code`` alone, plus the
-        echoed sub-command fields where the layout identifies itself by them (0x12)."""
+        echoed sub-command fields where the layout identifies itself by them (0x12; the focus
+        position reply's defaults are those)."""
         self.commands[message.NAME] += 1
         reply_cls = message.REPLY
         assert reply_cls is not None, f"{message.NAME} has no reply"
         if reply_cls is external.FocusCalibrationReply:
             return external.FocusCalibrationReply(code, external.FOCUS_CALIBRATION, external.FOCUS_MOTOR, 1)
-        if reply_cls is external.FocusPositionReply:
-            return external.FocusPositionReply(code, external.FOCUS_POSITION_QUERY, external.FOCUS_MOTOR)
         return reply_cls(return_code=code)
 
     def blocked(self) -> str | None:
