@@ -26,6 +26,6 @@ def test_every_frame_gives_a_sample_and_a_command(sequence, tracker):
     assert len(result.steps) == FRAMES
     first = result.steps[0].sample
     # at rest the view looks at the frame's centre: the subject starts left of it (x = 0.2 width)
-    assert first.in_view and first.dx < 0 and first.t == pytest.approx(0.0, abs=0.05)
+    assert first.in_view and first.dx < 0
     assert all(math.isfinite(s.sample.dx) and math.isfinite(s.command.yaw_dps) for s in result.steps)
     assert result.summary["frames"] == FRAMES and result.command_latencies
