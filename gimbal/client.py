@@ -103,6 +103,11 @@ def speed_message(yaw: float, pitch: float, roll: float = 0.0, *,
                         to_raw(pitch, "pitch speed"), ctrl)
 
 
+def stop_messages() -> tuple[SpeedControl, SpeedControl]:
+    """The safety stop: zero speed still in control, then zero with control released."""
+    return SpeedControl(0, 0, 0, SPEED_HOLD), SpeedControl(0, 0, 0, SPEED_RELEASE)
+
+
 def lookup(table: dict[str, int], value: str | int, what: str) -> int:
     """A named choice (or its raw number) from ``table``; RangeError otherwise."""
     if isinstance(value, int) and not isinstance(value, bool):
@@ -222,15 +227,14 @@ class GimbalClient:
         With a live receive thread each waits for its reply (no retries: a failure is logged);
         once the bus is known lost they are only sent, best effort.
         """
-        for ctrl in (SPEED_HOLD, SPEED_RELEASE):
-            message = SpeedControl(0, 0, 0, ctrl)
+        for message in stop_messages():
             try:
                 if self._rx_error is None and not self._closed:
                     self.request(message, retries=0)
                 else:
                     self.transport.send(self._encode(message)[1])
             except (GimbalError, can.CanError, OSError) as exc:
-                log.warning("safety stop (%s): %s", "zero speed" if ctrl & SPEED_TAKE_CONTROL
+                log.warning("safety stop (%s): %s", "zero speed" if message.ctrl_byte & SPEED_TAKE_CONTROL
                             else "release control", exc)
         self._speed_engaged = False
 

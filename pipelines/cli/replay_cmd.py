@@ -16,10 +16,10 @@ from typing import Any, TextIO
 
 import can
 
-from gimbal.client import SPEED_HOLD, SPEED_RELEASE, exit_on_signals
+from gimbal.client import exit_on_signals, stop_messages
 from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
 from gimbal.messages import message_packet
-from gimbal.messages.motion import SPEED_TAKE_CONTROL, SpeedControl, from_raw
+from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
 from gimbal.transport import CanTransport
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
@@ -267,9 +267,9 @@ def _send(bus: can.BusABC, frame: can.Message) -> None:
 def _stop_gimbal(bus: can.BusABC, tx_id: int, rx_id: int) -> None:
     """Best effort: zero speed, then zero with control released."""
     transport = CanTransport(bus, tx_id, rx_id)
-    for offset, ctrl in enumerate((SPEED_HOLD, SPEED_RELEASE)):
+    for offset, message in enumerate(stop_messages()):
         try:
-            transport.send(message_packet(SpeedControl(0, 0, 0, ctrl), STOP_SEQ + offset))
+            transport.send(message_packet(message, STOP_SEQ + offset))
         except (can.CanError, OSError) as exc:
             print(f"gimbaltrack replay: warning: could not send the stop: {exc}", file=sys.stderr)
             return
