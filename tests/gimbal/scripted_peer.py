@@ -11,6 +11,7 @@ from types import TracebackType
 import can
 from can.interfaces.virtual import VirtualBus
 
+from gimbal.client import SPEED_HOLD, SPEED_RELEASE
 from gimbal.framer import Dropped
 from gimbal.messages import Message, decode_message, message_packet
 from gimbal.messages.motion import SpeedControl
@@ -86,9 +87,6 @@ class ScriptedPeer:
     def push(self, message: Message, *, cmd_type: int | None = None, seq: int = 0) -> None:
         """Send a device push (or any message) unprompted."""
         self.transport.send(message_packet(message, seq, cmd_type))
-
-    def send_packet(self, packet: Packet | bytes) -> None:
-        self.transport.send(packet)
 
     def messages(self, cls: type[Message] | None = None) -> list[Message]:
         """Decoded commands and pushes received so far, optionally of one class."""
@@ -178,5 +176,7 @@ def speed_messages(peer: ScriptedPeer) -> list[tuple[int, int, int, int]]:
             for m in peer.messages(SpeedControl)]
 
 
-ZERO = (0, 0, 0, 0x88)  # zero speed, still in control
-RELEASE = (0, 0, 0, 0x08)  # zero speed, control released (bit 7 clear)
+# the client's own ctrl bytes, pinned to the protocol's values so the tests still check those
+assert (SPEED_HOLD, SPEED_RELEASE) == (0x88, 0x08), "speed ctrl bytes are not the R SDK's 0x88/0x08"
+ZERO = (0, 0, 0, SPEED_HOLD)  # zero speed, still in control
+RELEASE = (0, 0, 0, SPEED_RELEASE)  # zero speed, control released (bit 7 clear)
