@@ -7,6 +7,7 @@ import os
 import re
 import sys
 from collections.abc import Iterable, Iterator
+from contextlib import closing
 from typing import Any, TextIO
 
 import can
@@ -64,19 +65,29 @@ def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
         return 0
     if args.direction:
         raise CliError("--direction applies to --hex only; a log's directions come from its CAN ids")
-    frames, last = 0, None
-    reader = _open_log(args.log)
+    last = None
+    with closing(iter_log_frames(args.log, "decode")) as frames:
+        for frame in frames:
+            last = frame.timestamp
+            _emit(decoder.feed_frame(frame), out)
+    _emit(decoder.finish(last), out)
+    return 0
+
+
+def iter_log_frames(path: str, command: str) -> Iterator[can.Message]:
+    """The frames of a CAN log; ``CliError`` when it cannot be opened or read. A log without
+    frames gets a note on stderr from ``gimbaltrack <command>``."""
+    reader = _open_log(path)
+    frames = 0
     try:
         iterator = iter(reader)
-        while (frame := _next_frame(iterator, args.log, frames)) is not None:
-            frames, last = frames + 1, frame.timestamp
-            _emit(decoder.feed_frame(frame), out)
+        while (frame := _next_frame(iterator, path, frames)) is not None:
+            frames += 1
+            yield frame
     finally:
         _close(reader)
-    _emit(decoder.finish(last), out)
     if frames == 0:
-        print(f"gimbaltrack decode: note: {args.log} holds no CAN frames", file=sys.stderr)
-    return 0
+        print(f"gimbaltrack {command}: note: {path} holds no CAN frames", file=sys.stderr)
 
 
 def _next_frame(iterator: Iterator[can.Message], path: str, frames: int) -> can.Message | None:

@@ -9,7 +9,7 @@ import sys
 import time
 from collections import Counter
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
@@ -23,7 +23,7 @@ from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
 from gimbal.transport import CanTransport
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
-from pipelines.cli.decode_cmd import _close, _next_frame, _open_log
+from pipelines.cli.decode_cmd import _close, _open_log, iter_log_frames
 from pipelines.cli.sim_cmd import status_line
 
 ARROWS = {HOST_TO_GIMBAL: "host->gimbal", None: "?"}
@@ -221,10 +221,8 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
     decoder = LogDecoder(args.tx_id, args.rx_id)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
     skip_echoes = _marks_sent_frames(args.log, args.tx_id)
-    reader = _open_log(args.log)
-    try:
-        iterator = iter(reader)
-        while (frame := _next_frame(iterator, args.log, summary.frames)) is not None:
+    with closing(iter_log_frames(args.log, "replay")) as frames:
+        for frame in frames:
             if skip_echoes and frame.arbitration_id == args.tx_id and frame.is_rx:
                 summary.echoes += 1
                 continue
@@ -237,11 +235,7 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
                 _send(bus, frame)
                 summary.frames_sent += 1
             _emit(decoder.feed_frame(frame), summary, args.json, out)
-    finally:
-        _close(reader)
     _emit(decoder.finish(summary.last_t), summary, args.json, out)
-    if summary.frames == 0:
-        print(f"gimbaltrack replay: note: {args.log} holds no CAN frames", file=sys.stderr)
 
 
 def _marks_sent_frames(path: str, tx_id: int) -> bool:

@@ -105,3 +105,16 @@ def test_log_of_garbage_exits_0(tmp_path: Path, capsys: pytest.CaptureFixture[st
                                                    is_extended_id=False, timestamp=float(i), channel=0))
     code, records, _ = run([str(path)], capsys)
     assert code == 0 and records and all("error" in r for r in records)
+
+
+@pytest.mark.parametrize("command", ["decode", "replay"])
+def test_a_log_without_frames_is_a_note_and_exit_0(command: str, tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture[str],
+                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """decode and replay read logs through the same iter_log_frames."""
+    monkeypatch.setattr(pipelines.cli, "SUBCOMMAND_MODULES", [f"pipelines.cli.{command}_cmd"])
+    path = tmp_path / "empty.log"
+    path.write_text("")
+    assert main([command, str(path)]) == 0
+    err = capsys.readouterr().err
+    assert err == f"gimbaltrack {command}: note: {path} holds no CAN frames\n"
