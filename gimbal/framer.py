@@ -5,8 +5,8 @@ from collections import Counter
 from dataclasses import dataclass
 
 from gimbal.crc import crc16, crc32
-from gimbal.packet import (HEADER_LEN, MIN_PACKET_LEN, SOF, Packet, PacketError, declared_length,
-                           decode_packet)
+from gimbal.packet import (HEADER_LEN, MIN_PACKET_LEN, SOF, Packet, PacketError, _parse_verified,
+                           declared_length)
 
 DEFAULT_MAX_BUFFER = 4 * 1024
 
@@ -26,6 +26,7 @@ class PacketFramer:
     def __init__(self, max_buffer: int = DEFAULT_MAX_BUFFER) -> None:
         self._buffer = bytearray()
         self._scanned = 1  # offsets 1.._scanned-1 of the buffer cannot start a packet
+        self._header_ok = False  # the header at the front of the buffer passed its CRC16
         self._max_buffer = max(max_buffer, 1024)
         self.stats: Counter[str] = Counter()  # "packets" and one key per drop reason (in bytes)
 
@@ -55,6 +56,7 @@ class PacketFramer:
         dropped = Dropped(reason, bytes(self._buffer[:count]))
         del self._buffer[:count]
         self._scanned = 1
+        self._header_ok = False
         self.stats[reason] += count
         return dropped
 
@@ -75,9 +77,11 @@ class PacketFramer:
             return True
         if len(buf) < HEADER_LEN:
             return False
-        if crc16(bytes(buf[:10])) != int.from_bytes(buf[10:12], "little"):
-            out.append(self._drop("crc16", self._next_sof(1)))
-            return True
+        if not self._header_ok:
+            if crc16(bytes(buf[:10])) != int.from_bytes(buf[10:12], "little"):
+                out.append(self._drop("crc16", self._next_sof(1)))
+                return True
+            self._header_ok = True  # not checked again while the rest of the packet arrives
         if len(buf) < length:
             cut = self._complete_packet_inside(len(buf))
             if cut:  # a whole packet already follows: this one lost its tail
@@ -90,12 +94,13 @@ class PacketFramer:
             out.append(self._drop("truncated", cut) if cut else self._drop("crc32", length))
             return True
         try:
-            packet = decode_packet(raw)
-        except PacketError as exc:  # only "encrypted" can remain once both CRCs pass
+            packet = _parse_verified(raw)
+        except PacketError as exc:  # "encrypted"
             out.append(self._drop(exc.reason, length))
             return True
         del buf[:length]
         self._scanned = 1
+        self._header_ok = False
         self.stats["packets"] += 1
         out.append(packet)
         return True

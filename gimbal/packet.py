@@ -128,6 +128,12 @@ def decode_packet(raw: bytes) -> Packet:
         raise PacketError("crc16", "header CRC16 mismatch")
     if crc32(raw[:-4]) != int.from_bytes(raw[-4:], "little"):
         raise PacketError("crc32", "packet CRC32 mismatch")
+    return _parse_verified(raw)
+
+
+def _parse_verified(raw: bytes) -> Packet:
+    """Parse one packet whose SOF, length and both CRCs are known to be good (the framer checked
+    them); raises ``PacketError`` "encrypted"."""
     _, ver_len, cmd_type, enc, _, seq = _HEADER.unpack_from(raw)
     if enc >> 5:
         raise PacketError("encrypted", f"encrypted packet (ENC 0x{enc:02X}) is not supported: "
