@@ -37,12 +37,13 @@ class ControlConfig:
     target_accel_std_dps2: float = 300.0
     trust_memory_s: float = 1.0  # memory of the prediction scoring (PredictionTrust)
     reversal_factor: float = 2.0  # scoring horizon += this * (time to reverse the target's speed)
+    first_step_s: float = 1 / 30  # the first setpoint may step from rest by max_accel_dps2 * this
 
     def __post_init__(self) -> None:
         if not 0.0 < self.max_speed_dps <= PROTOCOL_MAX_SPEED_DPS:
             raise ValueError(f"max_speed_dps must be in (0, {PROTOCOL_MAX_SPEED_DPS:g}]")
-        if self.max_accel_dps2 <= 0 or self.hold_s < 0 or self.ramp_s <= 0:
-            raise ValueError("max_accel_dps2 and ramp_s must be positive, hold_s non-negative")
+        if self.max_accel_dps2 <= 0 or self.hold_s < 0 or self.ramp_s <= 0 or self.first_step_s <= 0:
+            raise ValueError("max_accel_dps2, ramp_s and first_step_s must be positive, hold_s non-negative")
         if self.max_speed_dps / self.ramp_s > self.max_accel_dps2 * (1 + 1e-9):
             raise ValueError("the stop ramp from max_speed_dps over ramp_s would exceed max_accel_dps2")
 
@@ -154,7 +155,8 @@ class RateController:
         without an estimate); when ``None`` it is dead-reckoned from the setpoints sent.
         """
         c = self.config
-        dt = 0.0 if self._last_now is None else now - self._last_now
+        # the first setpoint steps from rest as if the previous one (zero) were first_step_s old
+        dt = c.first_step_s if self._last_now is None else now - self._last_now
         self._last_now = now
         frame_t = estimate.timestamp if estimate is not None else now
         if attitude is not None:
@@ -177,7 +179,7 @@ class RateController:
         elif estimate is not None and self._direction is not None:
             self._direction = self._filter.update(None, frame_t)
 
-        if dt <= 0.0:  # first call, or no time has passed: nothing new to command
+        if dt <= 0.0:  # no time has passed: nothing new to command
             return self._last
         since = now - self._last_good
         if self._direction is None or since >= c.stop_within_s - 1e-9:

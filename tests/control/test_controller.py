@@ -185,3 +185,14 @@ def test_large_step_closes_fast_without_overshoot():
     assert -yaw_err.min() < 0.1 * 25.0
     t = tr.arr("t")[tr.arr("t") >= 1.0]
     assert t[np.argmax(np.abs(yaw_err) < 1.0)] - 1.0 < 0.6  # within 1 deg in under 0.6 s
+
+
+def test_the_first_detection_is_acted_on_within_the_acceleration_limit():
+    cfg = ControlConfig()
+    est = TargetEstimate((500.0, 170.0, 20.0, 20.0), (0, 0), 0.9, TrackState.TRACKING, 0.0, 0)
+    first = RateController(CAM, cfg).update(est, (0.0, 0.0), 0.004)
+    assert first.mode == "track"
+    assert 0.0 < first.yaw_dps <= cfg.max_accel_dps2 * cfg.first_step_s + 1e-9
+    assert first.pitch_dps == 0.0 and first.roll_dps == 0.0
+    with pytest.raises(ValueError):
+        ControlConfig(first_step_s=0.0)
