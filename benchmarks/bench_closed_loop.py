@@ -13,8 +13,9 @@ detections so the figures isolate the control loop).
   (hold the last direction, constant-velocity Kalman at several noise levels), without any
   acceleration limit. Not a proof over all predictors, the best of the usual ones.
 - acceleration: the best error with the WHOLE future known, at the simulator's 720 deg/s^2 per
-  axis, starting at rest and not moving before the first frame is processed (bounded least
-  squares over the axes' accelerations; scipy, which filterpy already requires).
+  axis and at the controller's own configured limit, starting at rest and not moving before the
+  first frame is processed (bounded least squares over the axes' accelerations; scipy, which
+  filterpy already requires).
 """
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ import numpy as np
 
 from gimbal.sim import SimConfig
 from pipelines.closed_loop import LoopSettings, run_closed_loop
+from pipelines.control.controller import ControlConfig
 from pipelines.control.direction import DirectionFilter
 from pipelines.virtual_camera import VirtualCamera
 from tracker.boxes import center
@@ -92,7 +94,7 @@ def _accel_bound(angles: np.ndarray, start_s: float, accel: float, fps: float, s
 
 
 def bounds(sequences: list[Path], fps: float = 30.0, processing_s: float = 0.004) -> None:
-    accel = SimConfig().accel_dps2
+    accel, own = SimConfig().accel_dps2, ControlConfig().max_accel_dps2
     for path in sequences:
         angles, to_diag = _truth_angles(path)
         for latency in LATENCIES_MS:
@@ -100,9 +102,10 @@ def bounds(sequences: list[Path], fps: float = 30.0, processing_s: float = 0.004
             preds = {f"{p} (accel std {s:g})": _prediction_rms(angles, ahead, p, s, fps) * to_diag
                      for p in ("hold", "cv") for s in (30.0, 100.0, 300.0, 1000.0)}
             best = min(preds, key=preds.get)
-            acc = _accel_bound(angles, latency / 1000 + processing_s, accel, fps) * to_diag
+            acc = [_accel_bound(angles, latency / 1000 + processing_s, a, fps) * to_diag for a in (accel, own)]
             print(f"{path.name:<14}{latency:>6} ms  information bound (frames <= k-{ahead}): "
-                  f"{preds[best]:.4f} [{best}]  acceleration bound ({accel:g} deg/s^2, future known): {acc:.4f}")
+                  f"{preds[best]:.4f} [{best}]  acceleration bound (future known): {acc[0]:.4f} at the "
+                  f"simulator's {accel:g} deg/s^2, {acc[1]:.4f} at the configured {own:g}")
 
 
 def main(argv: list[str]) -> int:
