@@ -1,0 +1,119 @@
+"""Our NanoTrack backend: the numpy post-processing on hand-made maps, and tracking with the models."""
+import numpy as np
+import pytest
+
+from tracker.boxes import iou
+from tracker.metrics import success_auc
+from tracker.nanotrack import (SCORE_SIZE, NanoTrackBackend, NanoTrackParams, change_penalty, crop_square,
+                               decode_boxes, foreground_score, grid_offsets, hanning_window, select_peak)
+from tracker.subject import SubjectTracker
+from tracker.synthetic import render_sequence
+
+
+def test_hanning_window_peaks_in_the_middle_and_vanishes_on_the_border():
+    window = hanning_window(16)
+    assert window.shape == (16, 16)
+    assert np.allclose(window, window.T)
+    assert window[0].max() == pytest.approx(0.0) and window[:, -1].max() == pytest.approx(0.0)
+    assert np.unravel_index(window.argmax(), window.shape) in {(7, 7), (7, 8), (8, 7), (8, 8)}
+
+
+def test_grid_offsets_step_by_the_stride_around_the_crop_centre():
+    offsets = grid_offsets(16, 16)
+    assert offsets[0] == -128 and offsets[8] == 0 and offsets[-1] == 112
+    assert np.all(np.diff(offsets) == 16)
+
+
+def test_foreground_score_is_a_softmax_over_the_two_channels():
+    cls = np.zeros((2, 3, 3), np.float32)
+    cls[1, 0, 0] = 50.0  # sure foreground, large logits must not overflow
+    cls[0, 2, 2] = np.log(3.0)  # background three times as likely
+    score = foreground_score(cls)
+    assert score[0, 0] == pytest.approx(1.0)
+    assert score[1, 1] == pytest.approx(0.5)
+    assert score[2, 2] == pytest.approx(0.25)
+
+
+def test_decode_boxes_turns_side_distances_into_centred_boxes():
+    offsets = grid_offsets(4, 16)  # -32, -16, 0, 16
+    loc = np.zeros((4, 4, 4), np.float32)
+    loc[:, :, :] = np.array([10.0, 5.0, 30.0, 15.0])[:, None, None]  # left, top, right, bottom
+    boxes = decode_boxes(loc, offsets)
+    assert boxes.shape == (4, 4, 4)
+    cx, cy, w, h = boxes[:, 1, 2]  # row 1 (y = -16), column 2 (x = 0)
+    assert (cx, cy, w, h) == pytest.approx((10.0, -11.0, 40.0, 20.0))
+
+
+def test_change_penalty_is_one_without_change_and_symmetric_in_scale():
+    k = 0.15
+    w = np.array([40.0, 80.0, 20.0, 40.0])
+    h = np.array([20.0, 40.0, 10.0, 40.0])
+    penalty = change_penalty(w, h, 40.0, 20.0, k)
+    assert penalty[0] == pytest.approx(1.0)
+    assert penalty[1] == pytest.approx(np.exp(-k))  # twice as big, same aspect ratio
+    assert penalty[2] == pytest.approx(penalty[1])  # half as big
+    assert penalty[3] < penalty[0]  # same area-ish, other aspect ratio
+
+
+def test_select_peak_trades_score_against_distance_from_the_centre():
+    boxes = decode_boxes(np.full((4, SCORE_SIZE, SCORE_SIZE), 20.0, np.float32), grid_offsets())
+    score = np.zeros((SCORE_SIZE, SCORE_SIZE), np.float32)
+    score[8, 8] = 0.6  # near the centre
+    score[1, 14] = 0.95  # near the border
+    window, target = hanning_window(SCORE_SIZE), np.array([40.0, 40.0])
+    (row, col), penalty = select_peak(score, boxes, target, window, NanoTrackParams())
+    assert (row, col) == (8, 8) and penalty == pytest.approx(1.0)
+    (row, col), _ = select_peak(score, boxes, target, window, NanoTrackParams(window_influence=0.0))
+    assert (row, col) == (1, 14)
+
+
+def test_select_peak_prefers_the_box_that_keeps_the_size():
+    loc = np.full((4, SCORE_SIZE, SCORE_SIZE), 20.0, np.float32)
+    loc[:, 8, 9] = 60.0  # a box three times as big, next to the centre
+    boxes = decode_boxes(loc, grid_offsets())
+    score = np.zeros((SCORE_SIZE, SCORE_SIZE), np.float32)
+    score[8, 8] = score[8, 9] = 0.9
+    (row, col), _ = select_peak(score, boxes, np.array([40.0, 40.0]), np.ones_like(score),
+                                NanoTrackParams(window_influence=0.0))
+    assert (row, col) == (8, 8)
+
+
+def test_crop_square_cuts_the_region_and_fills_outside_the_frame():
+    frame = np.arange(20 * 30 * 3, dtype=np.uint8).reshape(20, 30, 3)
+    crop = crop_square(frame, 15.0, 10.0, 10.0, 10, (1.0, 2.0, 3.0))
+    assert np.array_equal(crop, frame[5:15, 10:20])
+    corner = crop_square(frame, 0.0, 0.0, 10.0, 10, (1.0, 2.0, 3.0))
+    assert np.array_equal(corner[0, 0], [1, 2, 3])
+    assert np.array_equal(corner[5:, 5:], frame[:5, :5])
+
+
+def test_missing_model_files_raise_file_not_found(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nanotrack_backbone"):
+        NanoTrackBackend(tmp_path)
+    with pytest.raises(FileNotFoundError):
+        NanoTrackBackend(None)
+
+
+def test_update_before_init_is_an_error(shared_data):
+    backend = NanoTrackBackend(shared_data / "models")
+    with pytest.raises(RuntimeError, match="before init"):
+        backend.update(np.zeros((240, 320, 3), np.uint8))
+
+
+def test_follows_a_moving_target(shared_data):
+    seq = render_sequence(frames=50, speed=4.0, scale_change=1.3, seed=7)
+    backend = NanoTrackBackend(shared_data / "models")
+    backend.init(seq.frames[0], seq.boxes[0])
+    results = [backend.update(frame) for frame in seq.frames[1:]]
+    boxes = [seq.boxes[0]] + [box for box, _ in results]
+    assert success_auc(boxes, seq.boxes) > 0.7
+    assert iou(boxes[-1], seq.boxes[-1]) > 0.5
+    assert all(0.0 <= score <= 1.0 for _, score in results)
+
+
+def test_follows_a_moving_target_inside_the_subject_tracker(shared_data):
+    seq = render_sequence(frames=50, seed=7)
+    subject = SubjectTracker("nanotrack", NanoTrackBackend(shared_data / "models"))
+    estimates = [subject.init(seq.frames[0], seq.boxes[0], 0.0)]
+    estimates += [subject.update(frame, i / 30.0) for i, frame in enumerate(seq.frames[1:], 1)]
+    assert success_auc([e.box for e in estimates], seq.boxes) > 0.7

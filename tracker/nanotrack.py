@@ -1,0 +1,190 @@
+"""NanoTrack v2 run with ``cv2.dnn``: Siamese search and anchor-free box decoding in numpy.
+
+The two networks are NanoTrack's: a backbone (template 127 px -> 8x8 features, search 255 px ->
+16x16 features) and a neck/head correlating them into a 16x16 map of foreground scores and of
+box-side distances (left, top, right, bottom) from each map point, stride 16 px in the search
+crop. The post-processing is SiamBAN's: a penalty on changes of box size and aspect ratio, a
+cosine window favouring small motion, and a size learning rate scaled by the peak's score.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from tracker.boxes import Box
+from tracker.model_files import find_model_file
+
+EXEMPLAR_SIZE = 127  # template crop side, pixels
+INSTANCE_SIZE = 255  # search crop side, pixels
+STRIDE = 16  # search-crop pixels per score-map cell
+SCORE_SIZE = 16  # score map side (the head only accepts a 16x16 search feature map)
+MIN_SIZE = 10.0  # smallest box side kept, pixels
+
+
+@dataclass(frozen=True)
+class NanoTrackParams:
+    """Tracking hyperparameters; the defaults are the published NanoTrack v2 ones."""
+
+    window_influence: float = 0.490  # weight of the cosine window against the penalised score
+    penalty_k: float = 0.150  # strength of the size / aspect-ratio change penalty
+    size_lr: float = 0.385  # size learning rate at score 1
+    context_amount: float = 0.5  # context added around the box, in units of (w + h)
+    swap_rb: bool = False  # the networks were trained on BGR crops (OpenCV's TrackerNano swaps)
+    velocity_gain: float = 1.0  # search centre = last centre + gain x last frame's motion (0: last centre)
+
+
+def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
+    """The backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v2/``)."""
+    backbone = find_model_file(model_dir, "nanotrack_v2", "nanotrack_backbone*.onnx", "NanoTrack")
+    head = find_model_file(model_dir, "nanotrack_v2", "nanotrack_head*.onnx", "NanoTrack")
+    return backbone, head
+
+
+def hanning_window(size: int) -> np.ndarray:
+    """The ``size`` x ``size`` cosine (Hann) window, 1 near the centre and 0 on the border."""
+    hann = np.hanning(size)
+    return np.outer(hann, hann).astype(np.float32)
+
+
+def grid_offsets(size: int = SCORE_SIZE, stride: int = STRIDE) -> np.ndarray:
+    """Each score-map point's offset from the search crop's centre, crop pixels (1-D, per axis)."""
+    return ((np.arange(size) - size // 2) * stride).astype(np.float32)
+
+
+def foreground_score(cls: np.ndarray) -> np.ndarray:
+    """Softmax foreground probability from the head's (2, H, W) background/foreground logits."""
+    logits = cls - cls.max(axis=0, keepdims=True)
+    odds = np.exp(logits)
+    return odds[1] / odds.sum(axis=0)
+
+
+def decode_boxes(loc: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Boxes (cx, cy, w, h) per map point from the (4, H, W) side distances (l, t, r, b).
+
+    Centres are relative to the search crop's centre; all in crop pixels; shape (4, H, W).
+    """
+    gx, gy = offsets[None, :], offsets[:, None]
+    left, top, right, bottom = loc
+    x1, y1, x2, y2 = gx - left, gy - top, gx + right, gy + bottom
+    return np.stack([(x1 + x2) / 2, (y1 + y2) / 2, x2 - x1, y2 - y1])
+
+
+def padded_size(w: np.ndarray | float, h: np.ndarray | float) -> np.ndarray | float:
+    """SiamRPN's scale measure: the side of the square with the context-padded box's area."""
+    pad = (w + h) / 2
+    return np.sqrt((w + pad) * (h + pad))
+
+
+def change_penalty(w: np.ndarray, h: np.ndarray, target_w: float, target_h: float, k: float) -> np.ndarray:
+    """``exp(-k (r s - 1))`` where s, r >= 1 are the changes of scale and aspect ratio."""
+    scale = padded_size(w, h) / padded_size(target_w, target_h)
+    ratio = (target_w / target_h) / (w / np.maximum(h, 1e-6))
+    scale = np.maximum(scale, 1 / scale)
+    ratio = np.maximum(ratio, 1 / ratio)
+    return np.exp(-(ratio * scale - 1) * k)
+
+
+def select_peak(score: np.ndarray, boxes: np.ndarray, target_size: np.ndarray, window: np.ndarray,
+                params: NanoTrackParams) -> tuple[tuple[int, int], float]:
+    """The (row, col) maximising the penalised, windowed score, and the change penalty there.
+
+    ``boxes`` is :func:`decode_boxes`'s output and ``target_size`` the current (w, h), both in
+    search-crop pixels.
+    """
+    penalty = change_penalty(boxes[2], boxes[3], float(target_size[0]), float(target_size[1]), params.penalty_k)
+    pscore = penalty * score * (1 - params.window_influence) + window * params.window_influence
+    row, col = np.unravel_index(int(np.argmax(pscore)), pscore.shape)
+    return (int(row), int(col)), float(penalty[row, col])
+
+
+def crop_square(frame: np.ndarray, cx: float, cy: float, side: float, out: int,
+                fill: tuple[float, float, float]) -> np.ndarray:
+    """The square of ``side`` image pixels centred on (cx, cy), resampled to ``out`` x ``out``.
+
+    Centres are continuous coordinates (a pixel i spans [i, i + 1]); outside the frame is ``fill``.
+    """
+    k = out / side
+    shift_x = (0.5 - cx) * k + out / 2 - 0.5
+    shift_y = (0.5 - cy) * k + out / 2 - 0.5
+    matrix = np.array([[k, 0.0, shift_x], [0.0, k, shift_y]], dtype=np.float64)
+    return cv2.warpAffine(frame, matrix, (out, out), flags=cv2.INTER_LINEAR,
+                          borderMode=cv2.BORDER_CONSTANT, borderValue=fill)
+
+
+@dataclass(frozen=True)
+class Peak:
+    """The chosen score-map point: box (cx, cy, w, h) in image pixels, its score and penalty."""
+
+    box: tuple[float, float, float, float]
+    score: float
+    penalty: float
+
+
+class NanoTrackBackend:
+    """NanoTrack v2 (``TrackingBackend``): score = foreground probability of the chosen peak."""
+
+    def __init__(self, model_dir: str | Path | None, params: NanoTrackParams | None = None) -> None:
+        self.name = "nanotrack"
+        self.params = params or NanoTrackParams()
+        backbone, head = nanotrack_model_files(model_dir)
+        self._backbone = cv2.dnn.readNet(str(backbone))
+        self._head = cv2.dnn.readNet(str(head))
+        self._window = hanning_window(SCORE_SIZE)
+        self._offsets = grid_offsets()
+        self._center = np.zeros(2)
+        self._size = np.ones(2)
+        self._velocity = np.zeros(2)  # the centre's motion over the last frame, pixels
+        self._fill = (0.0, 0.0, 0.0)
+        self._ready = False
+
+    def init(self, frame: np.ndarray, box: Box) -> None:
+        x, y, w, h = (float(v) for v in box)
+        self._center = np.array([x + w / 2, y + h / 2])
+        self._size = np.array([max(w, 1.0), max(h, 1.0)])
+        self._velocity = np.zeros(2)
+        self._fill = tuple(float(v) for v in cv2.mean(frame)[:3])
+        template = crop_square(frame, *self._center, self._context_side(), EXEMPLAR_SIZE, self._fill)
+        self._head.setInput(self._features(template), "input1")
+        self._ready = True
+
+    def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
+        if not self._ready:
+            raise RuntimeError(f"{self.name}: update() before init()")
+        predicted = self._center + self.params.velocity_gain * self._velocity
+        peak = self._search(frame, predicted, INSTANCE_SIZE / EXEMPLAR_SIZE * self._context_side())
+        lr = peak.penalty * peak.score * self.params.size_lr  # a doubtful peak changes the size less
+        size = (1 - lr) * self._size + lr * np.array(peak.box[2:])
+        frame_size = np.array(frame.shape[1::-1], dtype=float)
+        center = np.clip(peak.box[:2], 0, frame_size)
+        self._velocity = center - self._center
+        self._center = center
+        self._size = np.clip(size, MIN_SIZE, frame_size)
+        (cx, cy), (w, h) = self._center, self._size
+        return (float(cx - w / 2), float(cy - h / 2), float(w), float(h)), float(np.clip(peak.score, 0, 1))
+
+    def _context_side(self) -> float:
+        """Side of the template crop: the box padded by ``context_amount`` (w + h), squared."""
+        w, h = self._size
+        pad = self.params.context_amount * (w + h)
+        return float(np.sqrt((w + pad) * (h + pad)))
+
+    def _features(self, crop: np.ndarray) -> np.ndarray:
+        blob = cv2.dnn.blobFromImage(crop, 1.0, swapRB=self.params.swap_rb)
+        self._backbone.setInput(blob)
+        return self._backbone.forward()
+
+    def _search(self, frame: np.ndarray, center: np.ndarray, side: float) -> Peak:
+        """The best peak in the search crop of ``side`` image pixels centred on ``center``."""
+        crop = crop_square(frame, *center, side, INSTANCE_SIZE, self._fill)
+        self._head.setInput(self._features(crop), "input2")
+        cls, loc = self._head.forward(["output1", "output2"])
+        score = foreground_score(cls[0])
+        boxes = decode_boxes(loc[0], self._offsets)
+        scale = INSTANCE_SIZE / side  # crop pixels per image pixel
+        (row, col), penalty = select_peak(score, boxes, self._size * scale, self._window, self.params)
+        bcx, bcy, bw, bh = boxes[:, row, col] / scale
+        box = (float(center[0] + bcx), float(center[1] + bcy), float(bw), float(bh))
+        return Peak(box, float(score[row, col]), penalty)
