@@ -26,7 +26,7 @@ MIN_SIZE = 10.0  # smallest box side kept, pixels
 
 @dataclass(frozen=True)
 class NanoTrackParams:
-    """Tracking hyperparameters; the defaults are the published NanoTrack v2 ones."""
+    """Tracking hyperparameters: the published NanoTrack v2 ones, plus our motion prediction."""
 
     window_influence: float = 0.490  # weight of the cosine window against the penalised score
     penalty_k: float = 0.150  # strength of the size / aspect-ratio change penalty
