@@ -1,0 +1,105 @@
+"""The correlation-filter tracker's parts: cell features, filters, colour model, and the backend."""
+import numpy as np
+import pytest
+
+from tracker.boxes import iou
+from tracker.colour_model import ColourModel, box_response, colour_index
+from tracker.correlation import ScaleFilter, TranslationFilter, gaussian_peak
+from tracker.dcf import DcfBackend
+from tracker.features import CELL, CHANNELS, SIGNED_BINS, cell_features
+from tracker.synthetic import render_sequence, texture
+
+
+def test_features_have_one_row_per_cell_and_image():
+    grey = np.random.default_rng(0).random((3, 32, 48), dtype=np.float32)
+    assert cell_features(grey).shape == (3, 32 // CELL, 48 // CELL, CHANNELS)
+
+
+def test_a_flat_image_has_no_gradient_and_its_grey_level():
+    features = cell_features(np.full((1, 16, 16), 0.75, np.float32))
+    assert np.all(features[..., :-1] == 0)
+    assert np.allclose(features[..., -1], 0.25)
+
+
+@pytest.mark.parametrize("rising, signed_bin", [(True, 0), (False, SIGNED_BINS // 2)])
+def test_a_horizontal_ramp_lands_in_its_orientation_bin(rising, signed_bin):
+    ramp = np.tile(np.linspace(0, 1, 32, dtype=np.float32), (32, 1))
+    features = cell_features((ramp if rising else ramp[:, ::-1].copy())[None])[0]
+    inner = features[2:-2, 2:-2]  # away from the zero-gradient border
+    assert np.all(np.argmax(inner[..., :SIGNED_BINS], axis=2) == signed_bin)
+    assert np.all(np.argmax(inner[..., SIGNED_BINS:SIGNED_BINS + SIGNED_BINS // 2], axis=2) == 0)
+
+
+def test_gaussian_peak_is_at_index_zero_and_wraps():
+    peak = gaussian_peak((8, 6), sigma=1.0)
+    assert peak[0, 0] == 1.0 and peak.argmax() == 0
+    assert peak[1, 0] == pytest.approx(peak[-1, 0]) and peak[0, 1] == pytest.approx(peak[0, -1])
+
+
+@pytest.mark.parametrize("shift", [(0, 0), (2, -3), (-4, 1)])
+def test_translation_filter_finds_a_shift(shift):
+    rng = np.random.default_rng(1)
+    features = rng.standard_normal((24, 24, 5)).astype(np.float32)
+    flt = TranslationFilter((24, 24), sigma=1.5)
+    flt.learn(features, rate=1.0)
+    response = flt.respond(np.roll(features, shift, axis=(0, 1)))
+    row, col = np.unravel_index(np.argmax(response), response.shape)
+    assert (row - 12, col - 12) == shift
+
+
+def test_scale_filter_finds_a_step():
+    rng = np.random.default_rng(2)
+    samples = rng.standard_normal((17, 40)).astype(np.float32)
+    flt = ScaleFilter(17, sigma=1.0)
+    flt.learn(samples, rate=1.0)
+    assert int(np.argmax(flt.respond(samples))) == 0
+    assert int(np.argmax(flt.respond(np.roll(samples, 2, axis=0)))) == 2
+
+
+def test_filters_refuse_to_respond_before_learning():
+    with pytest.raises(RuntimeError, match="before learn"):
+        TranslationFilter((8, 8), 1.0).respond(np.zeros((8, 8, 1), np.float32))
+    with pytest.raises(RuntimeError, match="before learn"):
+        ScaleFilter(5, 1.0).respond(np.zeros((5, 3), np.float32))
+
+
+def test_colour_model_tells_the_subject_from_the_background():
+    patch = np.zeros((40, 40, 3), np.uint8)
+    patch[..., 0] = 200  # blue background
+    patch[12:24, 12:24] = (0, 0, 220)  # a red subject on cells 3..5
+    foreground = np.zeros((40, 40), bool)
+    foreground[13:23, 13:23] = True
+    model = ColourModel()
+    model.learn(colour_index(patch), foreground, ~foreground, rate=1.0)
+    likelihood = model.likelihood(colour_index(patch))
+    assert likelihood[18, 18] > 0.9 and likelihood[2, 2] < 0.1
+    response = box_response(likelihood, 4, (3, 3))
+    assert np.unravel_index(np.argmax(response), response.shape) == (4, 4)
+
+
+def test_backend_follows_a_moving_target():
+    seq = render_sequence(frames=40, speed=3.0, seed=3)
+    backend = DcfBackend()
+    backend.init(seq.frames[0], seq.boxes[0])
+    for frame, truth in zip(seq.frames[1:], seq.boxes[1:]):
+        box, score = backend.update(frame)
+        assert iou(box, truth) > 0.8 and 0.0 <= score <= 1.0
+
+
+def test_backend_scores_drop_behind_an_occluder():
+    seq = render_sequence(frames=60, occlusion=(25, 45), seed=1)
+    backend = DcfBackend()
+    backend.init(seq.frames[0], seq.boxes[0])
+    scores = [backend.update(frame)[1] for frame in seq.frames[1:]]
+    hidden = [s for s, visible in zip(scores, seq.visible[1:]) if not visible]
+    assert max(scores[:10]) > 0.9
+    assert max(hidden[len(hidden) // 2:]) < 0.5
+
+
+def test_backend_works_on_grey_frames_and_at_the_frame_border():
+    rng = np.random.default_rng(4)
+    frame = texture(120, 160, rng, cell=6, contrast=0.8)[..., 0]
+    backend = DcfBackend()
+    backend.init(frame, (0.0, 0.0, 30.0, 30.0))  # the window reaches outside the frame
+    box, score = backend.update(frame)
+    assert iou(box, (0.0, 0.0, 30.0, 30.0)) > 0.8 and score > 0.9

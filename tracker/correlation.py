@@ -1,0 +1,84 @@
+"""Discriminative correlation filters learnt in the Fourier domain (multi-channel, linear kernel).
+
+``TranslationFilter`` answers "where did the patch move" on a 2-D cell grid; ``ScaleFilter``
+answers "by how much did it grow" over a 1-D stack of scale samples. Both keep running
+averages of the filter's numerator and denominator, as in MOSSE/DSST.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy import fft
+
+
+def gaussian_peak(shape: tuple[int, ...], sigma: float) -> np.ndarray:
+    """A Gaussian of ``sigma`` cells peaking at index 0 of every axis, wrapped around."""
+    grids = np.meshgrid(*[_wrapped_offsets(n) for n in shape], indexing="ij")
+    return np.exp(-0.5 * sum(g.astype(np.float64) ** 2 for g in grids) / sigma**2)
+
+
+def _wrapped_offsets(n: int) -> np.ndarray:
+    index = np.arange(n)
+    return np.where(index <= n // 2, index, index - n)
+
+
+class TranslationFilter:
+    """A correlation filter over ``(rows, cols, channels)`` cell features."""
+
+    def __init__(self, shape: tuple[int, int], sigma: float, regularisation: float = 1e-3) -> None:
+        rows, cols = shape
+        self.shape = shape
+        self._label = fft.rfft2(gaussian_peak(shape, sigma).astype(np.float32))[..., None]
+        self._window = (np.hanning(rows)[:, None] * np.hanning(cols)[None, :])[..., None]
+        self._regularisation = regularisation
+        self._numerator: np.ndarray | None = None
+        self._denominator: np.ndarray | None = None
+
+    def learn(self, features: np.ndarray, rate: float) -> None:
+        """Fold a training sample centred on the target into the filter (``rate`` 1 restarts)."""
+        spectrum = fft.rfft2(features * self._window, axes=(0, 1))
+        numerator = self._label * np.conj(spectrum)
+        denominator = np.sum((spectrum * np.conj(spectrum)).real, axis=2)
+        if self._numerator is None or rate >= 1.0:
+            self._numerator, self._denominator = numerator, denominator
+        else:
+            self._numerator = (1 - rate) * self._numerator + rate * numerator
+            self._denominator = (1 - rate) * self._denominator + rate * denominator
+
+    def respond(self, features: np.ndarray) -> np.ndarray:
+        """The response over the grid, zero displacement at the centre (``shape // 2``)."""
+        if self._numerator is None:
+            raise RuntimeError("TranslationFilter.respond() before learn()")
+        spectrum = fft.rfft2(features * self._window, axes=(0, 1))
+        product = np.sum(self._numerator * spectrum, axis=2) / (self._denominator + self._regularisation)
+        return np.fft.fftshift(fft.irfft2(product, s=self.shape))
+
+
+class ScaleFilter:
+    """A 1-D correlation filter over ``(scales, dims)`` samples, the middle scale being today's."""
+
+    def __init__(self, scales: int, sigma: float, regularisation: float = 1e-2) -> None:
+        self._scales = scales
+        self._label = fft.rfft(gaussian_peak((scales,), sigma).astype(np.float32))[:, None]
+        self._window = np.hanning(scales + 2)[1:-1, None].astype(np.float32)
+        self._regularisation = regularisation
+        self._numerator: np.ndarray | None = None
+        self._denominator: np.ndarray | None = None
+
+    def learn(self, samples: np.ndarray, rate: float) -> None:
+        """Fold samples taken around the current scale into the filter (``rate`` 1 restarts)."""
+        spectrum = fft.rfft(samples * self._window, axis=0)
+        numerator = self._label * np.conj(spectrum)
+        denominator = np.sum((spectrum * np.conj(spectrum)).real, axis=1)
+        if self._numerator is None or rate >= 1.0:
+            self._numerator, self._denominator = numerator, denominator
+        else:
+            self._numerator = (1 - rate) * self._numerator + rate * numerator
+            self._denominator = (1 - rate) * self._denominator + rate * denominator
+
+    def respond(self, samples: np.ndarray) -> np.ndarray:
+        """The response per scale sample, zero change at index 0 (wrapped like the label)."""
+        if self._numerator is None:
+            raise RuntimeError("ScaleFilter.respond() before learn()")
+        spectrum = fft.rfft(samples * self._window, axis=0)
+        product = np.sum(self._numerator * spectrum, axis=1) / (self._denominator + self._regularisation)
+        return fft.irfft(product, n=self._scales)

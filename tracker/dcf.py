@@ -1,0 +1,166 @@
+"""A fast correlation-filter tracker: gradient and colour cues, DSST-style scale (no model files).
+
+Each frame: cut a window around the last position (context around the subject, resized to
+a fixed cell grid), find the displacement from the blend of the translation filter's
+response and the colour model's, then the scale from the 1-D scale filter, and learn all
+three at the new position. The ideas are those of Staple (Bertinetto et al., 2016) and
+DSST (Danelljan et al., 2014); the implementation is our own, vectorised numpy.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from tracker.boxes import Box
+from tracker.colour_model import ColourModel, box_response, colour_index
+from tracker.correlation import ScaleFilter, TranslationFilter
+from tracker.features import CELL, cell_features
+
+
+@dataclass(frozen=True)
+class DcfSettings:
+    """Published defaults of the methods above, except where the comment says otherwise."""
+
+    context: float = 1.5  # window = subject + context x mean side (KCF's padding; Staple used 1.0)
+    window_area: float = 100.0**2  # the window is resized to about this many pixels (Staple: 150**2)
+    sigma_factor: float = 1 / 16  # label width relative to the subject's size
+    learning_rate: float = 0.01
+    colour_rate: float = 0.04
+    colour_weight: float = 0.3  # share of the colour response in the blend
+    inner_padding: float = 0.2  # foreground = subject shrunk by this x mean side
+    scales: int = 17
+    scale_step: float = 1.03
+    scale_area: float = 32.0**2  # scale samples are resized to about this many pixels
+    scale_rate: float = 0.025
+    min_scale: float = 0.2
+    max_scale: float = 5.0
+    peak_rate: float = 0.05  # how fast the typical response peak follows confident frames
+    learn_above: float = 0.4  # frames scoring lower (occluded, probably) teach the models nothing
+
+
+class DcfBackend:
+    """A :class:`tracker.backends.TrackingBackend`; the score is the filter's response peak."""
+
+    def __init__(self, settings: DcfSettings | None = None, name: str = "dcf") -> None:
+        self.name = name
+        self.settings = settings or DcfSettings()
+        self._center = np.zeros(2)
+        self._base_size = np.ones(2)
+        self._scale = 1.0
+        self._typical_peak = 0.0
+
+    def init(self, frame: np.ndarray, box: Box) -> None:
+        s = self.settings
+        x, y, w, h = box
+        self._center = np.array([x + w / 2.0, y + h / 2.0])
+        self._base_size = np.array([max(w, 2.0), max(h, 2.0)])
+        self._scale = 1.0
+        window = self._base_size + s.context * self._base_size.mean()
+        resize = np.sqrt(s.window_area / np.prod(window))
+        self._grid = np.maximum(np.round(window * resize / CELL).astype(int), 4)  # cols, rows
+        self._base_window = window
+        cells_per_px = self._grid / window
+        subject_cells = self._base_size * cells_per_px
+        self._colour_box = tuple(int(max(1, 2 * round(c / 2) + 1)) for c in subject_cells)
+        sigma = np.sqrt(np.prod(subject_cells)) * s.sigma_factor
+        self._translation = TranslationFilter((int(self._grid[1]), int(self._grid[0])), sigma)
+        self._colour = ColourModel()
+        self._masks = self._colour_masks(cells_per_px * CELL)
+        scale_resize = np.sqrt(s.scale_area / np.prod(self._base_size))
+        self._scale_px = np.maximum(np.round(self._base_size * scale_resize / CELL).astype(int), 2) * CELL
+        self._scale_factors = s.scale_step ** (np.arange(s.scales) - s.scales // 2)
+        self._scale_filter = ScaleFilter(s.scales, np.sqrt(s.scales) / 4)
+        self._typical_peak = 0.0
+        self._learn(frame, rate=1.0)
+
+    def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
+        s = self.settings
+        patch = self._window_patch(frame)
+        response = self._translation.respond(self._features(patch))
+        peak = float(response.max())
+        if s.colour_weight > 0:
+            colour = box_response(self._colour.likelihood(colour_index(patch)), CELL, self._colour_box)
+            response = (1 - s.colour_weight) * response + s.colour_weight * colour
+        row, col = np.unravel_index(int(np.argmax(response)), response.shape)
+        shift = np.array([col + _subcell(response[row, :], col), row + _subcell(response[:, col], row)])
+        shift -= np.array([response.shape[1] // 2, response.shape[0] // 2])
+        self._center = self._center + shift * CELL * (self._base_window * self._scale) / (self._grid * CELL)
+        samples = self._scale_samples(frame)
+        step = int(np.argmax(self._scale_filter.respond(samples)))
+        step = step if step <= s.scales // 2 else step - s.scales
+        if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
+            step = 0
+        self._scale *= s.scale_step**step
+        score = self._score(peak)
+        if score >= s.learn_above:
+            self._learn(frame, rate=None, scale_samples=np.roll(samples, -step, axis=0))  # re-centred on the new scale
+        w, h = self._base_size * self._scale
+        return (float(self._center[0] - w / 2), float(self._center[1] - h / 2), float(w), float(h)), score
+
+    def _score(self, peak: float) -> float:
+        """The peak relative to its running typical value: 1 as usual, towards 0 as it collapses."""
+        if self._typical_peak <= 0.0:
+            self._typical_peak = peak
+        score = float(np.clip(peak / max(self._typical_peak, 1e-6), 0.0, 1.0))
+        rate = self.settings.peak_rate * score
+        self._typical_peak = (1 - rate) * self._typical_peak + rate * peak
+        return score
+
+    def _learn(self, frame: np.ndarray, rate: float | None, scale_samples: np.ndarray | None = None) -> None:
+        s = self.settings
+        patch = self._window_patch(frame)
+        self._translation.learn(self._features(patch), rate or s.learning_rate)
+        if s.colour_weight > 0:
+            fg, bg = self._masks
+            self._colour.learn(colour_index(patch), fg, bg, rate or s.colour_rate)
+        if scale_samples is None:
+            scale_samples = self._scale_samples(frame)
+        self._scale_filter.learn(scale_samples, rate or s.scale_rate)
+
+    def _window_patch(self, frame: np.ndarray) -> np.ndarray:
+        window = self._base_window * self._scale
+        return _resized_crop(frame, self._center, window, tuple(int(v) for v in self._grid * CELL))
+
+    def _features(self, patch: np.ndarray) -> np.ndarray:
+        return cell_features(_grey(patch)[None])[0]
+
+    def _scale_samples(self, frame: np.ndarray) -> np.ndarray:
+        size = tuple(int(v) for v in self._scale_px)
+        crops = [_grey(_resized_crop(frame, self._center, self._base_size * self._scale * f, size))
+                 for f in self._scale_factors]
+        return cell_features(np.stack(crops)).reshape(len(crops), -1)
+
+    def _colour_masks(self, patch_per_px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Foreground (the subject shrunk) and background (outside it) masks of the window patch."""
+        width, height = (int(v) for v in self._grid * CELL)
+        subject = self._base_size * patch_per_px
+        inner = (self._base_size - self.settings.inner_padding * self._base_size.mean()) * patch_per_px
+        xs = np.abs(np.arange(width) + 0.5 - width / 2.0)[None, :]
+        ys = np.abs(np.arange(height) + 0.5 - height / 2.0)[:, None]
+        foreground = (xs <= max(inner[0], 1.0) / 2) & (ys <= max(inner[1], 1.0) / 2)
+        background = (xs > subject[0] / 2) | (ys > subject[1] / 2)
+        return foreground, background
+
+
+def _resized_crop(frame: np.ndarray, center: np.ndarray, size: np.ndarray, out: tuple[int, int]) -> np.ndarray:
+    """The ``size`` (w, h) window centred on ``center``, resized to ``out``; the border replicated."""
+    w, h = (max(2, int(round(v))) for v in size)
+    crop = cv2.getRectSubPix(frame, (w, h), (float(center[0]), float(center[1])))
+    interpolation = cv2.INTER_AREA if w > out[0] else cv2.INTER_LINEAR
+    return cv2.resize(crop, out, interpolation=interpolation)
+
+
+def _grey(patch: np.ndarray) -> np.ndarray:
+    grey = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY) if patch.ndim == 3 else patch
+    return grey.astype(np.float32) * (1.0 / 255.0)
+
+
+def _subcell(values: np.ndarray, index: int) -> float:
+    """Parabolic sub-cell offset of the peak at ``index`` in ``values`` (0 at the edges)."""
+    if index <= 0 or index >= len(values) - 1:
+        return 0.0
+    left, mid, right = values[index - 1], values[index], values[index + 1]
+    curvature = left - 2 * mid + right
+    return float(0.5 * (left - right) / curvature) if curvature < 0 else 0.0
