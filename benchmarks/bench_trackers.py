@@ -46,10 +46,13 @@ class BareBackend:
 def contenders(model_dir: Path | None) -> dict[str, object]:
     """Factories by label: OpenCV's trackers bare, then the project's subject trackers."""
     table = {f"opencv-{n}": (lambda n=n: BareBackend(make_backend(n, model_dir))) for n in ("mil", "kcf", "csrt")}
-    table["gimbaltrack default (no models)"] = lambda: make_tracker("default")
+    table["gimbaltrack csrt-fast"] = lambda: make_tracker("csrt-fast")
+    table["dcf backend alone"] = lambda: BareBackend(make_backend("dcf"))
+    table["gimbaltrack default (no models: dcf)"] = lambda: make_tracker("default")
     if model_dir is not None:
         table["opencv-nano"] = lambda: BareBackend(make_backend("nano", model_dir))
-        table["gimbaltrack default (models)"] = lambda: make_tracker("default", model_dir)
+        table["nanotrack backend alone"] = lambda: BareBackend(make_backend("nanotrack", model_dir))
+        table["gimbaltrack default (models: nanotrack)"] = lambda: make_tracker("default", model_dir)
     return table
 
 

@@ -1,4 +1,4 @@
-"""Tracking backends: one small interface over OpenCV's trackers and NanoTrack."""
+"""Tracking backends: one small interface over our correlation filter and NanoTrack, and OpenCV's trackers."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -9,7 +9,8 @@ import cv2
 import numpy as np
 
 from tracker.boxes import Box
-from tracker.model_files import find_model_file
+from tracker.dcf import DcfBackend
+from tracker.nanotrack import NanoTrackBackend, nanotrack_model_files
 
 
 class TrackingBackend(Protocol):
@@ -68,15 +69,8 @@ def _csrt(**overrides: float | bool) -> Callable[[], cv2.Tracker]:
 FAST_CSRT = {"template_size": 100.0, "use_segmentation": False}
 
 
-def nanotrack_files(model_dir: str | Path | None) -> tuple[Path, Path]:
-    """NanoTrack's backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v2/``)."""
-    backbone = find_model_file(model_dir, "nanotrack_v2", "nanotrack_backbone*.onnx", "NanoTrack")
-    head = find_model_file(model_dir, "nanotrack_v2", "nanotrack_head*.onnx", "NanoTrack")
-    return backbone, head
-
-
 def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
-    backbone, head = nanotrack_files(model_dir)
+    backbone, head = nanotrack_model_files(model_dir)
 
     def create() -> cv2.Tracker:
         params = cv2.TrackerNano_Params()
@@ -85,11 +79,15 @@ def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
     return create
 
 
-BACKEND_NAMES = ("csrt-fast", "csrt", "kcf", "mil", "mosse", "nano")
+BACKEND_NAMES = ("dcf", "nanotrack", "csrt-fast", "csrt", "kcf", "mil", "mosse", "nano")
 
 
 def make_backend(name: str, model_dir: str | Path | None = None) -> TrackingBackend:
-    """A fresh backend by name (one of ``BACKEND_NAMES``); ``nano`` needs ``model_dir``."""
+    """A fresh backend by name (one of ``BACKEND_NAMES``); ``nanotrack`` and ``nano`` need ``model_dir``."""
+    if name == "dcf":
+        return DcfBackend()
+    if name == "nanotrack":
+        return NanoTrackBackend(model_dir)
     if name == "csrt-fast":
         return OpenCvBackend(name, _csrt(**FAST_CSRT))
     if name == "csrt":

@@ -3,34 +3,38 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tracker.backends import BACKEND_NAMES, make_backend, nanotrack_files
-from tracker.subject import SubjectTracker
+from tracker.backends import BACKEND_NAMES, make_backend
+from tracker.nanotrack import nanotrack_model_files
+from tracker.subject import SubjectTracker, TrackerSettings
 
-DEFAULT_BACKEND = "csrt-fast"  # best measured without model files (docs/tracker.md)
-DEFAULT_WITH_MODELS = "nano"  # best measured when the NanoTrack files are given
+DEFAULT_BACKEND = "dcf"  # best measured without model files (docs/tracker.md)
+DEFAULT_WITH_MODELS = "nanotrack"  # best measured when the NanoTrack files are given
+# The template refinement corrects CSRT's drift; the correlation filter's own peak is finer.
+_SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0)}
 
 
 def available_trackers() -> list[str]:
-    """Names ``make_tracker`` accepts; ``nano`` also needs the NanoTrack model files."""
+    """Names ``make_tracker`` accepts; ``nanotrack`` and ``nano`` also need the NanoTrack model files."""
     return ["default", *BACKEND_NAMES]
 
 
 def make_tracker(name: str = "default", model_dir: str | Path | None = None) -> SubjectTracker:
     """A subject tracker by name.
 
-    ``default`` picks NanoTrack when ``model_dir`` holds its files, else the fast CSRT.
+    ``default`` picks NanoTrack when ``model_dir`` holds its files, else the correlation filter.
     Unknown names raise ``ValueError``; missing model files raise ``FileNotFoundError``.
     """
     if name == "default":
         name = DEFAULT_WITH_MODELS if model_dir is not None and _has_nanotrack(model_dir) else DEFAULT_BACKEND
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
-    return SubjectTracker(name, make_backend(name, model_dir))  # missing model files fail here, not on init()
+    backend = make_backend(name, model_dir)  # missing model files fail here, not on init()
+    return SubjectTracker(name, backend, settings=_SETTINGS.get(name))
 
 
 def _has_nanotrack(model_dir: str | Path) -> bool:
     try:
-        nanotrack_files(model_dir)
+        nanotrack_model_files(model_dir)
     except FileNotFoundError:
         return False
     return True

@@ -21,12 +21,13 @@ def _track(name, seq, model_dir=None):
 def test_available_trackers_lists_default_and_backends():
     names = available_trackers()
     assert names[0] == "default"
-    assert {"csrt-fast", "csrt", "kcf", "mil", "nano"} <= set(names)
+    assert {"dcf", "nanotrack", "csrt-fast", "csrt", "kcf", "mil", "nano"} <= set(names)
 
 
-def test_default_follows_a_moving_target():
+@pytest.mark.parametrize("name", ["default", "csrt-fast"])
+def test_follows_a_moving_target(name):
     seq = render_sequence(frames=60, seed=4)
-    estimates = _track("default", seq)
+    estimates = _track(name, seq)
     assert success_auc([e.box for e in estimates], seq.boxes) > 0.7
     assert all(e.state is TrackState.TRACKING for e in estimates)
     assert [e.frame_index for e in estimates] == list(range(60))
@@ -34,16 +35,17 @@ def test_default_follows_a_moving_target():
 
 def test_velocity_is_in_pixels_per_second():
     seq = render_sequence(frames=40, speed=3.0, seed=5)
-    # One frame's velocity follows CSRT's per-frame box jitter (up to ~2x either way); the units
-    # show in its mean over the last half second.
+    # One frame's velocity follows the backend's per-frame box jitter; the units show in its
+    # mean over the last half second.
     vx = np.mean([e.velocity[0] for e in _track("default", seq)[-15:]])
     assert vx == pytest.approx(3.0 * FPS, rel=0.2)
 
 
+@pytest.mark.parametrize("name", ["default", "csrt-fast"])
 @pytest.mark.parametrize("scale_change", [1.6, 0.7])
-def test_default_follows_scale_change(scale_change):
+def test_follows_scale_change(name, scale_change):
     seq = render_sequence(frames=60, scale_change=scale_change, seed=2)
-    last = _track("default", seq)[-1]
+    last = _track(name, seq)[-1]
     assert last.box[2] == pytest.approx(seq.boxes[-1][2], rel=0.25)
 
 
@@ -72,8 +74,9 @@ def test_lost_box_does_not_drift_away():
 def test_unknown_tracker_and_missing_model_files(tmp_path):
     with pytest.raises(ValueError, match="unknown tracker 'nope'"):
         make_tracker("nope")
-    with pytest.raises(FileNotFoundError, match="nanotrack_backbone"):
-        make_tracker("nano", tmp_path)
+    for name in ("nano", "nanotrack"):
+        with pytest.raises(FileNotFoundError, match="nanotrack_backbone"):
+            make_tracker(name, tmp_path)
     with pytest.raises(FileNotFoundError, match="model directory"):
         make_tracker("nano")
 
@@ -83,13 +86,13 @@ def test_update_before_init_is_an_error():
         make_tracker().update(np.zeros((10, 10, 3), np.uint8), 0.0)
 
 
-def test_default_without_nanotrack_files_is_csrt_fast(tmp_path):
-    assert make_tracker("default", tmp_path).name == "csrt-fast"
+def test_default_without_nanotrack_files_is_dcf(tmp_path):
+    assert make_tracker("default", tmp_path).name == "dcf"
 
 
 def test_nano_follows_and_is_default_with_model_files(shared_data):
     models = shared_data / "models"
-    assert make_tracker("default", models).name == "nano"
+    assert make_tracker("default", models).name == "nanotrack"
     seq = render_sequence(frames=50, seed=7)
     estimates = _track("default", seq, models)
     assert success_auc([e.box for e in estimates], seq.boxes) > 0.6
