@@ -112,8 +112,8 @@ def test_inverted_axes_flip_the_rates_on_the_bus(tmp_path: Path) -> None:
         return 230 + i % 3, 170  # right of and below the centre: normally yaw +, pitch -
 
     clip = make_clip(tmp_path / "clip.avi", 30, position)
-    assert run_track(clip, tmp_path / "out", "--roi", roi_at(position), "--no-video",
-                     "--invert-yaw", "--invert-pitch") == 0
+    assert run_track(clip, tmp_path / "out", "--roi", roi_at(position), "--no-video", "--realtime",
+                     "--invert-yaw", "--invert-pitch") == 0  # real time: a second of commands, not 0.1 s
     moving = [c for c in speed_commands(decoded(tmp_path / "out" / "can.log")) if not c.zero]
     assert len(moving) > 5
     assert all(c.yaw < 0 and c.pitch > 0 for c in moving)
