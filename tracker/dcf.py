@@ -32,7 +32,7 @@ class DcfSettings:
     inner_padding: float = 0.2  # foreground = subject shrunk by this x mean side
     scales: int = 17
     scale_step: float = 1.03
-    scale_area: float = 32.0**2  # scale samples are resized to about this many pixels
+    scale_area: float = 512.0  # scale samples are resized to about this many pixels (DSST's value)
     scale_rate: float = 0.025
     min_scale: float = 0.2
     max_scale: float = 5.0
