@@ -59,14 +59,14 @@ def test_avi_stays_readable_when_the_process_dies(tmp_path: Path, run_and_crash:
         from pipelines.outputs.annotated_video import AnnotatedVideoWriter
         writer = AnnotatedVideoWriter({str(path)!r}, (160, 120), 30.0)
         rng = np.random.default_rng(0)
-        for _ in range(60):
+        for _ in range(100):
             writer.write(rng.integers(0, 256, (120, 160, 3), dtype=np.uint8))
     """)
     capture = cv2.VideoCapture(str(path))
     count = 0
     while capture.read()[0]:
         count += 1
-    assert count >= 50  # all but what was still in FFmpeg's write buffer
+    assert count >= 60  # all but what was still in FFmpeg's write buffer (~25 frames of noise here)
 
 
 def test_background_writer_keeps_every_frame_in_order(tmp_path):
