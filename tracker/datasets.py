@@ -73,7 +73,8 @@ def load_sequence(path: str | Path, groundtruth: str | Path | None = None) -> Se
     """A sequence from a folder (OTB ``img/``, VOT ``imgs/`` or images directly) or a video file.
 
     The ground truth is ``groundtruth`` when given, else a ``groundtruth_rect.txt`` /
-    ``groundtruth.txt`` found in the folder (beside a video: those names or ``<stem>.txt``).
+    ``groundtruth.txt`` found in the folder (beside a video: those names, ``<stem>.txt`` or
+    ``<stem>_groundtruth.txt``).
     """
     path = Path(path)
     if not path.exists():
@@ -81,7 +82,8 @@ def load_sequence(path: str | Path, groundtruth: str | Path | None = None) -> Se
     if path.is_file():
         if path.suffix.lower() not in VIDEO_SUFFIXES:
             raise ValueError(f"not a video file or sequence folder: {path}")
-        gt_path = Path(groundtruth) if groundtruth else _find_groundtruth(path.parent, path.stem + ".txt")
+        gt_path = Path(groundtruth) if groundtruth else _find_groundtruth(path.parent, path.stem + ".txt",
+                                                                            path.stem + "_groundtruth.txt")
         truth = parse_groundtruth(gt_path) if gt_path else None
         if truth is not None and len(truth) > _video_frame_count(path):
             raise ValueError(f"{gt_path} has {len(truth)} boxes but {path} has fewer frames")

@@ -80,9 +80,10 @@ def _write_video(path: Path, count: int) -> None:
     writer.release()
 
 
-def test_video_with_groundtruth_beside_it(tmp_path):
+@pytest.mark.parametrize("name", ["clip.txt", "clip_groundtruth.txt"])
+def test_video_with_groundtruth_beside_it(tmp_path, name):
     _write_video(tmp_path / "clip.avi", 5)
-    (tmp_path / "clip.txt").write_text("1,2,3,4\n" * 4)
+    (tmp_path / name).write_text("1,2,3,4\n" * 4)
     seq = load_sequence(tmp_path / "clip.avi")
     assert len(seq) == 4 and len(list(seq.frames())) == 4
 
