@@ -18,8 +18,8 @@ class ProgressReporter:
         self.interval = interval if stream.isatty() else max(interval, 2.0)
         self.enabled = enabled
         self._tty = stream.isatty()
-        self._last = 0.0
         self._start = time.monotonic()
+        self._last = self._start  # the first line waits an interval, so its fps means something
         self._drawn = False
 
     def update(self, done: int, status: str | Callable[[], str] = "", force: bool = False) -> None:
