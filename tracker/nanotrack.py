@@ -172,6 +172,8 @@ class NanoTrackBackend:
         return float(np.sqrt((w + pad) * (h + pad)))
 
     def _features(self, crop: np.ndarray) -> np.ndarray:
+        if crop.ndim == 2:  # the networks take three channels
+            crop = cv2.cvtColor(crop, cv2.COLOR_GRAY2BGR)
         blob = cv2.dnn.blobFromImage(crop, 1.0, swapRB=self.params.swap_rb)
         self._backbone.setInput(blob)
         return self._backbone.forward()

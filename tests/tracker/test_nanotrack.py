@@ -1,4 +1,5 @@
 """Our NanoTrack backend: the numpy post-processing on hand-made maps, and tracking with the models."""
+import cv2
 import numpy as np
 import pytest
 
@@ -109,6 +110,15 @@ def test_follows_a_moving_target(shared_data):
     assert success_auc(boxes, seq.boxes) > 0.7
     assert iou(boxes[-1], seq.boxes[-1]) > 0.5
     assert all(0.0 <= score <= 1.0 for _, score in results)
+
+
+def test_grey_frames_are_tracked_too(shared_data):
+    seq = render_sequence(frames=20, seed=8)
+    grey = [cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) for frame in seq.frames]
+    backend = NanoTrackBackend(shared_data / "models")
+    backend.init(grey[0], seq.boxes[0])
+    box, _ = [backend.update(frame) for frame in grey[1:]][-1]
+    assert iou(box, seq.boxes[-1]) > 0.5
 
 
 def test_follows_a_moving_target_inside_the_subject_tracker(shared_data):
