@@ -8,6 +8,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from tracker.correlation import running_average
+
 BINS = 32
 _SHIFT = 8 - int(np.log2(BINS))
 
@@ -32,13 +34,8 @@ class ColourModel:
         size = BINS**3
         fg = np.bincount(bins[foreground], minlength=size).astype(np.float32)
         bg = np.bincount(bins[background], minlength=size).astype(np.float32)
-        fg /= max(fg.sum(), 1.0)
-        bg /= max(bg.sum(), 1.0)
-        if self._foreground is None or rate >= 1.0:
-            self._foreground, self._background = fg, bg
-        else:
-            self._foreground = (1 - rate) * self._foreground + rate * fg
-            self._background = (1 - rate) * self._background + rate * bg
+        self._foreground = running_average(self._foreground, fg / max(fg.sum(), 1.0), rate)
+        self._background = running_average(self._background, bg / max(bg.sum(), 1.0), rate)
 
     def likelihood(self, bins: np.ndarray) -> np.ndarray:
         """Per pixel, P(subject | colour) in 0..1 (0 for colours never seen)."""

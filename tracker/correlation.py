@@ -16,6 +16,13 @@ def gaussian_peak(shape: tuple[int, ...], sigma: float) -> np.ndarray:
     return np.exp(-0.5 * sum(g.astype(np.float64) ** 2 for g in grids) / sigma**2)
 
 
+def running_average(old: np.ndarray | None, new: np.ndarray, rate: float) -> np.ndarray:
+    """``new`` when there is no ``old`` or ``rate`` >= 1 (a restart), else ``(1 - rate) old + rate new``."""
+    if old is None or rate >= 1.0:
+        return new
+    return (1 - rate) * old + rate * new
+
+
 def _wrapped_offsets(n: int) -> np.ndarray:
     index = np.arange(n)
     return np.where(index <= n // 2, index, index - n)
@@ -36,13 +43,8 @@ class TranslationFilter:
     def learn(self, features: np.ndarray, rate: float) -> None:
         """Fold a training sample centred on the target into the filter (``rate`` 1 restarts)."""
         spectrum = fft.rfft2(features * self._window, axes=(0, 1))
-        numerator = self._label * np.conj(spectrum)
-        denominator = np.sum((spectrum * np.conj(spectrum)).real, axis=2)
-        if self._numerator is None or rate >= 1.0:
-            self._numerator, self._denominator = numerator, denominator
-        else:
-            self._numerator = (1 - rate) * self._numerator + rate * numerator
-            self._denominator = (1 - rate) * self._denominator + rate * denominator
+        self._numerator = running_average(self._numerator, self._label * np.conj(spectrum), rate)
+        self._denominator = running_average(self._denominator, np.sum(np.abs(spectrum) ** 2, axis=2), rate)
 
     def respond(self, features: np.ndarray) -> np.ndarray:
         """The response over the grid, zero displacement at the centre (``shape // 2``)."""
@@ -67,13 +69,8 @@ class ScaleFilter:
     def learn(self, samples: np.ndarray, rate: float) -> None:
         """Fold samples taken around the current scale into the filter (``rate`` 1 restarts)."""
         spectrum = fft.rfft(samples * self._window, axis=0)
-        numerator = self._label * np.conj(spectrum)
-        denominator = np.sum((spectrum * np.conj(spectrum)).real, axis=1)
-        if self._numerator is None or rate >= 1.0:
-            self._numerator, self._denominator = numerator, denominator
-        else:
-            self._numerator = (1 - rate) * self._numerator + rate * numerator
-            self._denominator = (1 - rate) * self._denominator + rate * denominator
+        self._numerator = running_average(self._numerator, self._label * np.conj(spectrum), rate)
+        self._denominator = running_average(self._denominator, np.sum(np.abs(spectrum) ** 2, axis=1), rate)
 
     def respond(self, samples: np.ndarray) -> np.ndarray:
         """The response per scale sample, zero change at index 0 (wrapped like the label)."""
