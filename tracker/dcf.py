@@ -41,7 +41,9 @@ class DcfSettings:
 
 
 class DcfBackend:
-    """A :class:`tracker.backends.TrackingBackend`; the score is the filter's response peak."""
+    """A :class:`tracker.backends.TrackingBackend`; the score is the translation filter's response
+    peak relative to its running typical value (1 as usual, falling towards 0 as the subject
+    is hidden or changes faster than the models learn)."""
 
     def __init__(self, settings: DcfSettings | None = None, name: str = "dcf") -> None:
         self.name = name
@@ -50,6 +52,7 @@ class DcfBackend:
         self._base_size = np.ones(2)
         self._scale = 1.0
         self._typical_peak = 0.0
+        self._translation: TranslationFilter | None = None
 
     def init(self, frame: np.ndarray, box: Box) -> None:
         s = self.settings
@@ -76,6 +79,8 @@ class DcfBackend:
         self._learn(frame, rate=1.0)
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
+        if self._translation is None:
+            raise RuntimeError(f"{self.name}: update() before init()")
         s = self.settings
         patch = self._window_patch(frame)
         response = self._translation.respond(self._features(patch))

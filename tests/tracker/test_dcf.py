@@ -56,6 +56,11 @@ def test_scale_filter_finds_a_step():
     assert int(np.argmax(flt.respond(np.roll(samples, 2, axis=0)))) == 2
 
 
+def test_backend_update_before_init_is_an_error():
+    with pytest.raises(RuntimeError, match="before init"):
+        DcfBackend().update(np.zeros((48, 64, 3), np.uint8))
+
+
 def test_filters_refuse_to_respond_before_learning():
     with pytest.raises(RuntimeError, match="before learn"):
         TranslationFilter((8, 8), 1.0).respond(np.zeros((8, 8, 1), np.float32))
