@@ -76,13 +76,13 @@ class DcfBackend:
         self._scale_factors = s.scale_step ** (np.arange(s.scales) - s.scales // 2)
         self._scale_filter = ScaleFilter(s.scales, np.sqrt(s.scales) / 4)
         self._typical_peak = 0.0
-        self._learn(frame, rate=1.0)
+        self._learn(self._region(frame), rate=1.0)
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
         if self._translation is None:
             raise RuntimeError(f"{self.name}: update() before init()")
         s = self.settings
-        patch = self._window_patch(frame)
+        patch = self._window_patch(self._region(frame))
         response = self._translation.respond(self._features(patch))
         peak = float(response.max())
         if s.colour_weight > 0:
@@ -92,7 +92,8 @@ class DcfBackend:
         shift = np.array([col + _subcell(response[row, :], col), row + _subcell(response[:, col], row)])
         shift -= np.array([response.shape[1] // 2, response.shape[0] // 2])
         self._center = self._center + shift * CELL * (self._base_window * self._scale) / (self._grid * CELL)
-        samples = self._scale_samples(frame)
+        region = self._region(frame)
+        samples = self._scale_samples(region)
         step = int(np.argmax(self._scale_filter.respond(samples)))
         step = step if step <= s.scales // 2 else step - s.scales
         if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
@@ -100,7 +101,9 @@ class DcfBackend:
         self._scale *= s.scale_step**step
         score = self._score(peak)
         if score >= s.learn_above:
-            self._learn(frame, rate=None, scale_samples=np.roll(samples, -step, axis=0))  # re-centred on the new scale
+            if step != 0:
+                region = self._region(frame)  # the window follows the new scale
+            self._learn(region, rate=None, scale_samples=np.roll(samples, -step, axis=0))  # re-centred on it
         w, h = self._base_size * self._scale
         return (float(self._center[0] - w / 2), float(self._center[1] - h / 2), float(w), float(h)), score
 
@@ -113,28 +116,35 @@ class DcfBackend:
         self._typical_peak = (1 - rate) * self._typical_peak + rate * peak
         return score
 
-    def _learn(self, frame: np.ndarray, rate: float | None, scale_samples: np.ndarray | None = None) -> None:
+    def _learn(self, region: _Region, rate: float | None, scale_samples: np.ndarray | None = None) -> None:
         s = self.settings
-        patch = self._window_patch(frame)
+        patch = self._window_patch(region)
         self._translation.learn(self._features(patch), rate or s.learning_rate)
         if s.colour_weight > 0:
             fg, bg = self._masks
             self._colour.learn(colour_index(patch), fg, bg, rate or s.colour_rate)
         if scale_samples is None:
-            scale_samples = self._scale_samples(frame)
+            scale_samples = self._scale_samples(region)
         self._scale_filter.learn(scale_samples, rate or s.scale_rate)
 
-    def _window_patch(self, frame: np.ndarray) -> np.ndarray:
-        window = self._base_window * self._scale
-        return _resized_crop(frame, self._center, window, tuple(int(v) for v in self._grid * CELL))
+    def _region(self, frame: np.ndarray) -> _Region:
+        """The window around the subject, cut once per position and scale; every patch comes from it."""
+        return _Region.cut(frame, self._center, self._base_window * self._scale, self._grid * CELL)
+
+    def _window_patch(self, region: _Region) -> np.ndarray:
+        size = tuple(int(v) for v in self._grid * CELL)
+        window = self._base_window * self._scale / region.k
+        return _resized_crop(region.image, region.to_region(self._center), window, size)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
         return cell_features(_grey(patch)[None])[0]
 
-    def _scale_samples(self, frame: np.ndarray) -> np.ndarray:
+    def _scale_samples(self, region: _Region) -> np.ndarray:
+        """The subject's box at every scale factor, each resized to the scale model's size."""
         size = tuple(int(v) for v in self._scale_px)
-        crops = [_grey(_resized_crop(frame, self._center, self._base_size * self._scale * f, size))
-                 for f in self._scale_factors]
+        center = region.to_region(self._center)
+        subject = self._base_size * self._scale / region.k
+        crops = [_grey(_resized_crop(region.image, center, subject * f, size)) for f in self._scale_factors]
         return cell_features(np.stack(crops)).reshape(len(crops), -1)
 
     def _colour_masks(self, patch_per_px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -149,12 +159,51 @@ class DcfBackend:
         return foreground, background
 
 
-def _resized_crop(frame: np.ndarray, center: np.ndarray, size: np.ndarray, out: tuple[int, int]) -> np.ndarray:
+@dataclass(frozen=True)
+class _Region:
+    """The part of a frame a window covers, averaged down by a whole factor ``k`` when the window
+    is over twice a patch's resolution (so that a large subject costs no more than a small one).
+    Its pixels are the frame's own (k = 1) or exact k x k means: crops from it equal crops from
+    the frame."""
+
+    image: np.ndarray
+    origin: tuple[int, int]  # the frame pixel at the region's (0, 0)
+    k: int  # frame pixels per region pixel, each way
+
+    @classmethod
+    def cut(cls, frame: np.ndarray, center: np.ndarray, window: np.ndarray, patch: np.ndarray) -> _Region:
+        k = max(1, int(np.min(window / (2 * patch))))
+        height, width = frame.shape[:2]
+        (x0, x1), (y0, y1) = (_span(c, half + k, size, k) for c, half, size in  # + bilinear reach
+                              zip(center, window / 2.0 + 2, (width, height)))
+        image = frame[y0:y1, x0:x1]
+        if k > 1:
+            image = cv2.resize(image, ((x1 - x0) // k, (y1 - y0) // k), interpolation=cv2.INTER_AREA)
+        return cls(image, (x0, y0), k)
+
+    def to_region(self, point: np.ndarray) -> tuple[float, float]:
+        """A frame point in region pixel coordinates."""
+        shift = (self.k - 1) / 2.0  # region pixel j is centred on frame pixel origin + j k + shift
+        return ((point[0] - self.origin[0] - shift) / self.k, (point[1] - self.origin[1] - shift) / self.k)
+
+
+def _span(center: float, half: float, size: int, k: int) -> tuple[int, int]:
+    """Whole-pixel bounds in 0..size covering ``center`` +- ``half``, their length a multiple of k."""
+    start = int(np.clip(np.floor(center - half), 0, size - 1))
+    end = int(np.clip(np.ceil(center + half), start + 1, size))
+    end = start + max(k, (end - start) // k * k)
+    return (start, end) if end <= size else (max(0, size - (end - start)), size)
+
+
+def _resized_crop(image: np.ndarray, center: tuple[float, float], size: np.ndarray, out: tuple[int, int]) -> np.ndarray:
     """The ``size`` (w, h) window centred on ``center``, resized to ``out``; the border replicated."""
     w, h = (max(2, int(round(v))) for v in size)
-    crop = cv2.getRectSubPix(frame, (w, h), (float(center[0]), float(center[1])))
-    interpolation = cv2.INTER_AREA if w > out[0] else cv2.INTER_LINEAR
-    return cv2.resize(crop, out, interpolation=interpolation)
+    crop = cv2.getRectSubPix(image, (w, h), center)
+    return cv2.resize(crop, out, interpolation=_interpolation(w, out[0]))
+
+
+def _interpolation(width: int, out_width: int) -> int:
+    return cv2.INTER_AREA if width > out_width else cv2.INTER_LINEAR
 
 
 def _grey(patch: np.ndarray) -> np.ndarray:

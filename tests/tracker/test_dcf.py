@@ -91,6 +91,16 @@ def test_backend_follows_a_moving_target():
         assert iou(box, truth) > 0.8 and 0.0 <= score <= 1.0
 
 
+def test_backend_follows_a_subject_filling_much_of_the_frame():
+    """A window over twice the patch size is averaged down first (the large-subject path)."""
+    seq = render_sequence(frames=30, frame_size=(800, 600), target=240, speed=6.0, scale_change=1.3, seed=3)
+    backend = DcfBackend()
+    backend.init(seq.frames[0], seq.boxes[0])
+    boxes = [backend.update(frame)[0] for frame in seq.frames[1:]]
+    assert min(iou(box, truth) for box, truth in zip(boxes, seq.boxes[1:])) > 0.75
+    assert boxes[-1][2] > 1.15 * seq.boxes[0][2]  # it grew with the subject
+
+
 def test_backend_scores_drop_behind_an_occluder():
     seq = render_sequence(frames=60, occlusion=(25, 45), seed=1)
     backend = DcfBackend()
