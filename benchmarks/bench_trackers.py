@@ -4,7 +4,7 @@ Prints per-sequence success AUC, mean AUC, mean precision@20px, median fps of th
 step (one thread; wall clock, and process CPU time, which the machine's other load affects less)
 and ratios against OpenCV's CSRT measured alongside. Usage:
 
-    .venv/bin/python benchmarks/bench_trackers.py [--model-dir DIR] [--only NAME ...]
+    .venv/bin/python benchmarks/bench_trackers.py [--model-dir DIR] [--only NAME ...] [--starts] [SEQ ...]
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from tracker.boxes import Box
 from tracker.data_paths import shared_data_dir, shared_sequences
 from tracker.datasets import load_sequence
 from tracker.estimate import TargetEstimate, TrackState
-from tracker.evaluation import SequenceResult, run_sequence, summarize
+from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
 from tracker.registry import make_tracker
 
 BASELINE = "opencv-csrt"
@@ -61,9 +61,14 @@ def main(argv: list[str] | None = None) -> int:
     default_models = shared_data_dir() / "models"
     parser.add_argument("--model-dir", type=Path, default=default_models if default_models.is_dir() else None)
     parser.add_argument("--only", nargs="*", help="labels to run (the CSRT baseline always runs)")
+    parser.add_argument("--starts", action="store_true",
+                        help="also track from OTB's perturbed first boxes and print each tracker's mean AUC "
+                             "over all starts (steadier than one start)")
+    parser.add_argument("sequences", nargs="*", type=Path,
+                        help="sequence folders or videos with ground truth (default: every shared sequence)")
     args = parser.parse_args(argv)
     cv2.setNumThreads(1)
-    sequences = [load_sequence(p) for p in shared_sequences()]
+    sequences = [load_sequence(p) for p in (args.sequences or shared_sequences())]
     if not sequences:
         print(f"no sequences under {shared_data_dir() / 'sequences'}", file=sys.stderr)
         return 2
@@ -74,7 +79,24 @@ def main(argv: list[str] | None = None) -> int:
         print(f"running {label} ...", file=sys.stderr, flush=True)
         results[label] = [run_sequence(table[label](), seq) for seq in sequences]
     _print_table(results, [s.name for s in sequences])
+    if args.starts:
+        _print_starts({label: table[label] for label in labels}, sequences, results)
     return 0
+
+
+def _print_starts(table: dict[str, object], sequences: list, results: dict[str, list[SequenceResult]]) -> None:
+    """Mean AUC per sequence over the given start and ``PERTURBED_STARTS``."""
+    print(f"\nmean AUC over {1 + len(PERTURBED_STARTS)} starts (the first box, then shifted/scaled):")
+    print(f"| tracker | {' | '.join(s.name.split('_', 1)[-1][:8] for s in sequences)} | mean |")
+    print("|---" * (len(sequences) + 2) + "|")
+    for label, factory in table.items():
+        print(f"running {label} from perturbed starts ...", file=sys.stderr, flush=True)
+        means = []
+        for seq, first in zip(sequences, results[label]):
+            aucs = [first.auc] + [run_sequence(factory(), seq, start=perturbed_box(seq.groundtruth[0], *p)).auc
+                                  for p in PERTURBED_STARTS]
+            means.append(float(np.mean(aucs)))
+        print(f"| {label} | {' | '.join(f'{m:.2f}' for m in means)} | {np.mean(means):.3f} |")
 
 
 def _print_table(results: dict[str, list[SequenceResult]], names: list[str]) -> None:

@@ -1,8 +1,13 @@
 """Hand-computed IoU, precision and success-AUC cases."""
+import cv2
 import pytest
 
 from tracker.boxes import iou, polygon_to_box
+from tracker.datasets import Sequence
+from tracker.estimate import TargetEstimate, TrackState
+from tracker.evaluation import PERTURBED_STARTS, perturbed_box, run_sequence
 from tracker.metrics import SUCCESS_THRESHOLDS, precision_at, success_auc, success_curve
+from tracker.synthetic import render_sequence
 
 
 def test_iou_hand_cases():
@@ -40,3 +45,29 @@ def test_precision_counts_centre_errors_up_to_the_limit():
 def test_mismatched_lengths_are_rejected():
     with pytest.raises(ValueError, match="equal"):
         success_auc([(0, 0, 1, 1)], [])
+
+
+def test_perturbed_box_shifts_in_box_sizes_and_scales_about_the_centre():
+    assert perturbed_box((10.0, 20.0, 40.0, 20.0), 0.1, -0.5, 1.0) == pytest.approx((14.0, 10.0, 40.0, 20.0))
+    assert perturbed_box((10.0, 20.0, 40.0, 20.0), 0.0, 0.0, 0.5) == pytest.approx((20.0, 25.0, 20.0, 10.0))
+    assert len(set(PERTURBED_STARTS)) == len(PERTURBED_STARTS) and (0.0, 0.0, 1.0) not in PERTURBED_STARTS
+
+
+def test_run_sequence_starts_from_the_given_box(tmp_path):
+    seq = render_sequence(frames=5, seed=0)
+    paths = tuple(tmp_path / f"{i}.png" for i in range(5))
+    for path, frame in zip(paths, seq.frames):
+        cv2.imwrite(str(path), frame)
+    start = perturbed_box(seq.boxes[0], 0.1, 0.0, 1.0)
+    sequence = Sequence("synthetic", frame_paths=paths, groundtruth=tuple(seq.boxes))
+    recorded = []
+
+    class Recorder:
+        def init(self, frame, box, timestamp):
+            recorded.append(box)
+
+        def update(self, frame, timestamp):
+            return TargetEstimate(start, (0.0, 0.0), 1.0, TrackState.TRACKING, timestamp, 0)
+
+    result = run_sequence(Recorder(), sequence, start=start)
+    assert recorded == [start] and result.boxes[0] == start
