@@ -4,7 +4,7 @@ Prints per-sequence success AUC, mean AUC, mean precision@20px, median fps of th
 step (one thread; wall clock, and process CPU time, which the machine's other load affects less)
 and ratios against OpenCV's CSRT measured alongside. Usage:
 
-    .venv/bin/python benchmarks/bench_trackers.py [--model-dir DIR] [--only NAME ...] [--starts] [SEQ ...]
+    .venv/bin/python benchmarks/bench_trackers.py [--model-dir DIR] [--only LABEL]... [--starts] [SEQ ...]
 """
 from __future__ import annotations
 
@@ -60,7 +60,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     default_models = shared_data_dir() / "models"
     parser.add_argument("--model-dir", type=Path, default=default_models if default_models.is_dir() else None)
-    parser.add_argument("--only", nargs="*", help="labels to run (the CSRT baseline always runs)")
+    parser.add_argument("--only", action="append", metavar="LABEL",
+                        help="a label to run, repeatable (the CSRT baseline always runs)")
     parser.add_argument("--starts", action="store_true",
                         help="also track from OTB's perturbed first boxes and print each tracker's mean AUC "
                              "over all starts (steadier than one start)")
@@ -68,7 +69,11 @@ def main(argv: list[str] | None = None) -> int:
                         help="sequence folders or videos with ground truth (default: every shared sequence)")
     args = parser.parse_args(argv)
     cv2.setNumThreads(1)
-    sequences = [load_sequence(p) for p in (args.sequences or shared_sequences())]
+    try:
+        sequences = [load_sequence(p) for p in (args.sequences or shared_sequences())]
+    except (OSError, ValueError) as exc:
+        print(f"bench_trackers: {exc}", file=sys.stderr)
+        return 2
     if not sequences:
         print(f"no sequences under {shared_data_dir() / 'sequences'}", file=sys.stderr)
         return 2
