@@ -18,7 +18,7 @@ import numpy as np
 from tracker.backends import TrackingBackend, make_backend
 from tracker.boxes import Box
 from tracker.data_paths import shared_data_dir, shared_sequences
-from tracker.datasets import load_sequence
+from tracker.datasets import Sequence, load_sequence
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
 from tracker.registry import make_tracker
@@ -89,7 +89,8 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _print_starts(table: dict[str, object], sequences: list, results: dict[str, list[SequenceResult]]) -> None:
+def _print_starts(table: dict[str, object], sequences: list[Sequence],
+                  results: dict[str, list[SequenceResult]]) -> None:
     """Mean AUC per sequence over the given start and ``PERTURBED_STARTS``."""
     print(f"\nmean AUC over {1 + len(PERTURBED_STARTS)} starts (the first box, then shifted/scaled):")
     print(f"| tracker | {' | '.join(s.name.split('_', 1)[-1][:8] for s in sequences)} | mean |")

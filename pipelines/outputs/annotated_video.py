@@ -13,8 +13,8 @@ import numpy as np
 
 from tracker.estimate import TargetEstimate, TrackState
 
-#: Container suffix -> FourCC, both FFmpeg's MPEG-4 part 2 encoder (2.4x faster than Motion JPEG
-#: at 720p, files ~10x smaller). An .mp4 is finalised by ``close()``; an .avi stays readable up
+#: Container suffix -> FourCC, both FFmpeg's MPEG-4 part 2 encoder (about twice as fast as Motion JPEG
+#: at 720p, files several times smaller). An .mp4 is finalised by ``close()``; an .avi stays readable up
 #: to the last frames that reached the disk even if the process is killed.
 CODECS = {".mp4": "mp4v", ".avi": "XVID"}
 STATE_COLOURS = {  # BGR
