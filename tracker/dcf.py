@@ -62,17 +62,18 @@ class DcfBackend:
         self._scale = 1.0
         window = self._base_size + s.context * self._base_size.mean()
         resize = np.sqrt(s.window_area / np.prod(window))
-        self._grid = np.maximum(np.round(window * resize / CELL).astype(int), 4)  # cols, rows
+        grid = np.maximum(np.round(window * resize / CELL).astype(int), 4)  # cols, rows
+        self._patch_size = (int(grid[0]) * CELL, int(grid[1]) * CELL)  # the window patch, px
         self._base_window = window
-        cells_per_px = self._grid / window
+        cells_per_px = grid / window
         subject_cells = self._base_size * cells_per_px
         self._colour_box = tuple(int(max(1, 2 * round(c / 2) + 1)) for c in subject_cells)
         sigma = np.sqrt(np.prod(subject_cells)) * s.sigma_factor
-        self._translation = TranslationFilter((int(self._grid[1]), int(self._grid[0])), sigma)
+        self._translation = TranslationFilter((int(grid[1]), int(grid[0])), sigma)
         self._colour = ColourModel()
         self._masks = self._colour_masks(cells_per_px * CELL)
         scale_resize = np.sqrt(s.scale_area / np.prod(self._base_size))
-        self._scale_px = np.maximum(np.round(self._base_size * scale_resize / CELL).astype(int), 2) * CELL
+        self._scale_px = tuple(int(v) * CELL for v in np.maximum(np.round(self._base_size * scale_resize / CELL), 2))
         self._scale_factors = s.scale_step ** (np.arange(s.scales) - s.scales // 2)
         self._scale_filter = ScaleFilter(s.scales, np.sqrt(s.scales) / 4)
         self._typical_peak = 0.0
@@ -91,7 +92,7 @@ class DcfBackend:
         row, col = np.unravel_index(int(np.argmax(response)), response.shape)
         shift = np.array([col + _subcell(response[row, :], col), row + _subcell(response[:, col], row)])
         shift -= np.array([response.shape[1] // 2, response.shape[0] // 2])
-        self._center = self._center + shift * CELL * (self._base_window * self._scale) / (self._grid * CELL)
+        self._center = self._center + shift * CELL * (self._base_window * self._scale) / np.array(self._patch_size)
         region = self._region(frame)
         samples = self._scale_samples(region)
         step = int(np.argmax(self._scale_filter.respond(samples)))
@@ -129,27 +130,25 @@ class DcfBackend:
 
     def _region(self, frame: np.ndarray) -> _Region:
         """The window around the subject, cut once per position and scale; every patch comes from it."""
-        return _Region.cut(frame, self._center, self._base_window * self._scale, self._grid * CELL)
+        return _Region.cut(frame, self._center, self._base_window * self._scale, np.array(self._patch_size))
 
     def _window_patch(self, region: _Region) -> np.ndarray:
-        size = tuple(int(v) for v in self._grid * CELL)
         window = self._base_window * self._scale / region.k
-        return _resized_crop(region.image, region.to_region(self._center), window, size)
+        return _resized_crop(region.image, region.to_region(self._center), window, self._patch_size)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
         return cell_features(_grey(patch)[None])[0]
 
     def _scale_samples(self, region: _Region) -> np.ndarray:
         """The subject's box at every scale factor, each resized to the scale model's size."""
-        size = tuple(int(v) for v in self._scale_px)
         center = region.to_region(self._center)
         subject = self._base_size * self._scale / region.k
-        crops = [_grey(_resized_crop(region.image, center, subject * f, size)) for f in self._scale_factors]
+        crops = [_grey(_resized_crop(region.image, center, subject * f, self._scale_px)) for f in self._scale_factors]
         return cell_features(np.stack(crops)).reshape(len(crops), -1)
 
     def _colour_masks(self, patch_per_px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Foreground (the subject shrunk) and background (outside it) masks of the window patch."""
-        width, height = (int(v) for v in self._grid * CELL)
+        width, height = self._patch_size
         subject = self._base_size * patch_per_px
         inner = (self._base_size - self.settings.inner_padding * self._base_size.mean()) * patch_per_px
         xs = np.abs(np.arange(width) + 0.5 - width / 2.0)[None, :]
