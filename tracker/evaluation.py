@@ -8,7 +8,7 @@ from typing import Protocol
 
 import numpy as np
 
-from tracker.boxes import Box
+from tracker.boxes import Box, center, from_center
 from tracker.datasets import ASSUMED_FPS, Sequence
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.metrics import precision_at, success_auc
@@ -46,9 +46,9 @@ PERTURBED_STARTS = ((0.1, 0.0, 1.0), (0.0, 0.1, 1.0), (-0.1, -0.1, 1.0), (0.0, 0
 
 def perturbed_box(box: Box, dx: float, dy: float, scale: float) -> Box:
     """``box`` moved by ``dx``, ``dy`` box sizes and scaled about its centre by ``scale``."""
-    x, y, w, h = box
-    cx, cy = x + w / 2 + dx * w, y + h / 2 + dy * h
-    return (cx - w * scale / 2, cy - h * scale / 2, w * scale, h * scale)
+    cx, cy = center(box)
+    w, h = box[2], box[3]
+    return from_center(cx + dx * w, cy + dy * h, w * scale, h * scale)
 
 
 def run_sequence(tracker: Trackable, sequence: Sequence,
