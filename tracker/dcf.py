@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tracker.boxes import Box
+from tracker.boxes import Box, center, from_center
 from tracker.colour_model import ColourModel, box_response, colour_index
 from tracker.correlation import ScaleFilter, TranslationFilter
 from tracker.features import CELL, cell_features
@@ -56,9 +56,8 @@ class DcfBackend:
 
     def init(self, frame: np.ndarray, box: Box) -> None:
         s = self.settings
-        x, y, w, h = box
-        self._center = np.array([x + w / 2.0, y + h / 2.0])
-        self._base_size = np.array([max(w, 2.0), max(h, 2.0)])
+        self._center = np.array(center(box))
+        self._base_size = np.array([max(box[2], 2.0), max(box[3], 2.0)])
         self._scale = 1.0
         window = self._base_size + s.context * self._base_size.mean()
         resize = np.sqrt(s.window_area / np.prod(window))
@@ -106,7 +105,7 @@ class DcfBackend:
                 region = self._region(frame)  # the window follows the new scale
             self._learn(region, rate=None, scale_samples=np.roll(samples, -step, axis=0))  # re-centred on it
         w, h = self._base_size * self._scale
-        return (float(self._center[0] - w / 2), float(self._center[1] - h / 2), float(w), float(h)), score
+        return from_center(float(self._center[0]), float(self._center[1]), float(w), float(h)), score
 
     def _score(self, peak: float) -> float:
         """The peak relative to its running typical value: 1 as usual, towards 0 as it collapses."""

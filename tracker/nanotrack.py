@@ -14,7 +14,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tracker.boxes import Box
+from tracker.boxes import Box, from_center
 from tracker.model_files import find_model_file
 
 EXEMPLAR_SIZE = 127  # template crop side, pixels
@@ -163,7 +163,7 @@ class NanoTrackBackend:
         self._center = center
         self._size = np.clip(size, MIN_SIZE, frame_size)
         (cx, cy), (w, h) = self._center, self._size
-        return (float(cx - w / 2), float(cy - h / 2), float(w), float(h)), float(np.clip(peak.score, 0, 1))
+        return from_center(float(cx), float(cy), float(w), float(h)), float(np.clip(peak.score, 0, 1))
 
     def _context_side(self) -> float:
         """Side of the template crop: the box padded by ``context_amount`` (w + h), squared."""
