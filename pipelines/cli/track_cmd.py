@@ -16,7 +16,7 @@ from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter, LoggingBus
 from pipelines.sources import FrameSource, SourceError, open_source
-from pipelines.track_session import FEEDBACK_MODES, TrackOptions, TrackSession
+from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession
 from tracker import available_trackers
 
 DEFAULT_DETECTOR = "motion"
@@ -71,6 +71,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--max-frames", type=int, help="stop after this many frames")
     run.add_argument("--out", type=Path, default=Path("out/track"), help="output folder (default: out/track)")
     run.add_argument("--no-video", action="store_true", help="do not write the annotated video")
+    run.add_argument("--video-width", type=int, default=DEFAULT_VIDEO_WIDTH, metavar="PX",
+                     help=f"shrink the annotated video to at most this width (default: {DEFAULT_VIDEO_WIDTH}, "
+                     "cheap to encode; 0: the source's full size)")
     run.add_argument("--quiet", action="store_true", help="no progress line")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_bus_options(parser, default_interface="sim")
@@ -86,6 +89,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError("--rate must be positive")
     if args.max_speed is not None and not 0 < args.max_speed <= PROTOCOL_MAX_SPEED_DPS:
         raise CliError(f"--max-speed takes 0 < DEG_S <= {PROTOCOL_MAX_SPEED_DPS:g} (the protocol's limit)")
+    if args.video_width < 0 or args.video_width == 1:
+        raise CliError("--video-width takes 0 (full size) or at least 2 pixels")
     if args.max_frames is not None and args.max_frames < 1:
         raise CliError("--max-frames must be at least 1")
     detect = args.detect or (None if roi else DEFAULT_DETECTOR)
@@ -95,7 +100,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         hfov_deg=args.hfov, rate_hz=args.rate, max_speed_dps=args.max_speed, record=args.record,
         realtime=args.realtime, attitude_feedback=args.attitude_feedback,
         yaw_sign=-1 if args.invert_yaw else 1, pitch_sign=-1 if args.invert_pitch else 1,
-        max_frames=args.max_frames, video=not args.no_video, progress=not args.quiet)
+        max_frames=args.max_frames, video=not args.no_video, video_width=args.video_width or None,
+        progress=not args.quiet)
 
 
 def run_track(args: argparse.Namespace) -> int:

@@ -35,10 +35,12 @@ def _put_lines(image: np.ndarray, lines: Sequence[str]) -> None:
 
 
 def annotate(image: np.ndarray, estimate: TargetEstimate | None = None,
-             rates_dps: tuple[float, float] | None = None, lines: Sequence[str] = ()) -> np.ndarray:
+             rates_dps: tuple[float, float] | None = None, lines: Sequence[str] = (),
+             scale: float = 1.0) -> np.ndarray:
     """A copy of ``image`` with the image centre, and if given the box coloured by state, the subject
     centre cross, the error vector from image centre to subject centre, the state, confidence and
-    commanded yaw/pitch rates (°/s), then any extra text ``lines``."""
+    commanded yaw/pitch rates (°/s), then any extra text ``lines``. ``scale``: image pixels per
+    pixel of the estimate's frame (for an image shrunk from that frame)."""
     out = image.copy()
     height, width = out.shape[:2]
     centre = (width // 2, height // 2)
@@ -46,9 +48,9 @@ def annotate(image: np.ndarray, estimate: TargetEstimate | None = None,
     text = []
     if estimate is not None:
         colour = STATE_COLOURS[estimate.state]
-        subject = tuple(round(v) for v in estimate.center)
+        subject = tuple(round(v * scale) for v in estimate.center)
         cv2.arrowedLine(out, centre, subject, (255, 255, 0), 2, cv2.LINE_AA, tipLength=0.08)
-        x, y, w, h = (round(v) for v in estimate.box)
+        x, y, w, h = (round(v * scale) for v in estimate.box)
         cv2.rectangle(out, (x, y), (x + w, y + h), colour, 2)
         cv2.drawMarker(out, subject, colour, cv2.MARKER_CROSS, 16, 2)
         text.append(f"#{estimate.frame_index} t={estimate.timestamp:.3f}s "
@@ -59,17 +61,38 @@ def annotate(image: np.ndarray, estimate: TargetEstimate | None = None,
     return out
 
 
-class AnnotatedVideoWriter:
-    """Writes annotated frames as they come (.mp4 or .avi, MPEG-4 part 2); ``close()`` finalises."""
+def video_size(size: tuple[int, int], max_width: int | None) -> tuple[int, int]:
+    """The written size for frames of ``size``: shrunk to at most ``max_width`` pixels wide (same
+    aspect ratio, even sides as the encoder needs), or ``size`` itself when it fits or when
+    ``max_width`` is None."""
+    width, height = size
+    if max_width is None or width <= max_width:
+        return size
+    scale = max_width / width
+    return max(2, round(width * scale / 2) * 2), max(2, round(height * scale / 2) * 2)
 
-    def __init__(self, path: str | os.PathLike[str], size: tuple[int, int], fps: float) -> None:
+
+class AnnotatedVideoWriter:
+    """Writes annotated frames as they come (.mp4 or .avi, MPEG-4 part 2); ``close()`` finalises.
+
+    ``size`` is the frames' size; with ``max_width`` wider frames are shrunk before drawing, so the
+    file is ``video_size(size, max_width)`` (encoding is most of the cost: a 1280x720 frame takes
+    about 3.6 ms of CPU, the same frame at 640x360 about 1.6 ms including the shrinking).
+    """
+
+    def __init__(self, path: str | os.PathLike[str], size: tuple[int, int], fps: float,
+                 max_width: int | None = None) -> None:
         self.path = Path(path)
         codec = CODECS.get(self.path.suffix.lower())
         if codec is None:
             raise ValueError(f"annotated video must end in {' or '.join(CODECS)}: {self.path}")
+        if max_width is not None and max_width < 2:
+            raise ValueError(f"max_width must be at least 2 pixels, got {max_width}")
         self.size = size
+        self.video_size = video_size(size, max_width)
+        self._scale = self.video_size[0] / size[0]
         self._writer = cv2.VideoWriter(str(self.path), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*codec),
-                                       fps, size)
+                                       fps, self.video_size)
         if not self._writer.isOpened():
             raise OSError(f"cannot write video {self.path}")
         self.frames = 0
@@ -80,7 +103,9 @@ class AnnotatedVideoWriter:
         height, width = image.shape[:2]
         if (width, height) != self.size:
             raise ValueError(f"frame is {width}x{height}, video is {self.size[0]}x{self.size[1]}")
-        self._writer.write(annotate(image, estimate, rates_dps, lines))
+        if self.video_size != self.size:
+            image = cv2.resize(image, self.video_size, interpolation=cv2.INTER_AREA)
+        self._writer.write(annotate(image, estimate, rates_dps, lines, self._scale))
         self.frames += 1
 
     def close(self) -> None:
@@ -101,9 +126,10 @@ class BackgroundVideoWriter:
     raised by the next ``write`` or by ``close``."""
 
     def __init__(self, path: str | os.PathLike[str], size: tuple[int, int], fps: float,
-                 queue_size: int = 32) -> None:
-        self._writer = AnnotatedVideoWriter(path, size, fps)
+                 max_width: int | None = None, queue_size: int = 32) -> None:
+        self._writer = AnnotatedVideoWriter(path, size, fps, max_width)
         self.path = self._writer.path
+        self.video_size = self._writer.video_size
         self._queue: queue.Queue[tuple | None] = queue.Queue(maxsize=queue_size)
         self._error: BaseException | None = None
         self._reported = False

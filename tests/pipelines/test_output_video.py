@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pipelines.outputs.annotated_video import (STATE_COLOURS, AnnotatedVideoWriter,
-                                               BackgroundVideoWriter, annotate)
+                                               BackgroundVideoWriter, annotate, video_size)
 from pipelines.sources import open_source
 from tracker.estimate import TargetEstimate, TrackState
 
@@ -90,3 +90,30 @@ def test_background_writer_reports_a_worker_failure_once(tmp_path):
     with pytest.raises(ValueError, match="frame is 10x10"):
         writer.close()  # drains the queue, then reports what failed
     writer.close()  # already reported: quiet
+
+
+@pytest.mark.parametrize("size, max_width, expected", [
+    ((1280, 720), 640, (640, 360)),
+    ((1920, 1080), 640, (640, 360)),
+    ((1000, 563), 640, (640, 360)),  # even sides for the encoder
+    ((640, 360), 640, (640, 360)),
+    ((320, 240), 640, (320, 240)),  # never enlarged
+    ((1280, 720), None, (1280, 720)),
+])
+def test_video_size_shrinks_wide_frames_to_even_sides(size, max_width, expected) -> None:
+    assert video_size(size, max_width) == expected
+
+
+def test_shrunk_video_keeps_the_annotation_on_the_subject(tmp_path: Path) -> None:
+    path = tmp_path / "small.avi"
+    estimate = TargetEstimate((200.0, 100.0, 80.0, 60.0), (0.0, 0.0), 0.9, TrackState.LOST, 0.0, 0)
+    with AnnotatedVideoWriter(path, (320, 240), 30.0, max_width=160) as writer:
+        assert writer.video_size == (160, 120)
+        writer.write(np.zeros((240, 320, 3), np.uint8), estimate)
+    ok, frame = cv2.VideoCapture(str(path)).read()
+    assert ok and frame.shape == (120, 160, 3)
+    # the box's left edge at x = 200 / 2, between y = 50 and 80, in red (lossy: roughly)
+    edge = frame[55:75, 99:102].reshape(-1, 3).mean(axis=0)
+    assert edge[2] > 120 and edge[0] < 80 and edge[1] < 80
+    with pytest.raises(ValueError, match="max_width must be at least 2"):
+        AnnotatedVideoWriter(tmp_path / "bad.avi", (320, 240), 30.0, max_width=1)

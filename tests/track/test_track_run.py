@@ -140,3 +140,20 @@ def test_rates_ramp_to_zero_when_the_subject_leaves(tmp_path: Path) -> None:
     # the streamed commands end at rest too
     speeds = speed_commands(decoded(tmp_path / "out" / "can.log"))
     assert all(c.zero for c in speeds[-5:])
+
+
+@pytest.mark.parametrize("width, expected", [("160", (160, 120)), ("0", SIZE)])
+def test_annotated_video_is_shrunk_to_the_chosen_width(tmp_path: Path, width: str,
+                                                       expected: tuple[int, int]) -> None:
+    def position(i: int) -> tuple[int, int]:
+        return 100 + i, 80
+
+    clip = make_clip(tmp_path / "clip.avi", 10, position)
+    assert run_track(clip, tmp_path / "out", "--roi", roi_at(position), "--video-width", width) == 0
+    ok, frame = cv2.VideoCapture(str(tmp_path / "out" / "annotated.avi")).read()
+    assert ok and frame.shape[1::-1] == expected
+
+
+def test_demo_video_keeps_its_size_under_the_default_width(demo_run: dict[str, Any]) -> None:
+    ok, frame = cv2.VideoCapture(str(demo_run["out"] / "annotated.avi")).read()
+    assert ok and frame.shape[1::-1] == (640, 360)
