@@ -74,6 +74,7 @@ class DcfBackend:
         scale_resize = np.sqrt(s.scale_area / np.prod(self._base_size))
         self._scale_px = tuple(int(v) * CELL for v in np.maximum(np.round(self._base_size * scale_resize / CELL), 2))
         self._scale_factors = s.scale_step ** (np.arange(s.scales) - s.scales // 2)
+        self._scale_offsets = _sample_offsets(self._scale_px, self._scale_factors)
         self._scale_filter = ScaleFilter(s.scales, np.sqrt(s.scales) / 4)
         self._typical_peak = 0.0
         self._learn(self._region(frame), rate=1.0)
@@ -139,11 +140,26 @@ class DcfBackend:
         return cell_features(_grey(patch)[None])[0]
 
     def _scale_samples(self, region: _Region) -> np.ndarray:
-        """The subject's box at every scale factor, each resized to the scale model's size."""
-        center = region.to_region(self._center)
-        subject = self._base_size * self._scale / region.k
-        crops = [_grey(_resized_crop(region.image, center, subject * f, self._scale_px)) for f in self._scale_factors]
-        return cell_features(np.stack(crops)).reshape(len(crops), -1)
+        """The subject's box at every scale factor, resampled to the scale model's size in one remap
+        of the grey region, first averaged down so that the largest box is about that size (each
+        sample is then bilinear at up to 1:1, free of aliasing; per-sample area resizing took twice
+        as long and scored the same)."""
+        grey = _grey(region.image)
+        subject = self._base_size * self._scale / region.k  # region pixels
+        shrink = min(1.0, float(np.min(np.array(self._scale_px) / (subject * self._scale_factors[-1]))))
+        if shrink < 1.0:
+            size = (max(1, round(grey.shape[1] * shrink)), max(1, round(grey.shape[0] * shrink)))
+            grey = cv2.resize(grey, size, interpolation=cv2.INTER_AREA)
+        ratio = np.array([grey.shape[1] / region.image.shape[1], grey.shape[0] / region.image.shape[0]])
+        centre = (np.array(region.to_region(self._center)) + 0.5) * ratio - 0.5
+        span = subject * ratio
+        offset_x, offset_y = self._scale_offsets
+        scales, height, width = offset_x.shape
+        map_x = (offset_x * np.float32(span[0]) + np.float32(centre[0])).reshape(-1, width)
+        map_y = (offset_y * np.float32(span[1]) + np.float32(centre[1])).reshape(-1, width)
+        samples = cv2.remap(grey, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        samples = samples.reshape(scales, height, width)
+        return cell_features(samples).reshape(len(samples), -1)
 
     def _colour_masks(self, patch_per_px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Foreground (the subject shrunk) and background (outside it) masks of the window patch."""
@@ -198,6 +214,17 @@ def _resized_crop(image: np.ndarray, center: tuple[float, float], size: np.ndarr
     w, h = (max(2, int(round(v))) for v in size)
     crop = cv2.getRectSubPix(image, (w, h), center)
     return cv2.resize(crop, out, interpolation=_interpolation(w, out[0]))
+
+
+def _sample_offsets(size: tuple[int, int], factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each scale sample's pixel centres relative to the subject's centre, in subject sizes:
+    x and y, each ``(scales, height, width)`` float32."""
+    width, height = size
+    xs = (np.arange(width) + 0.5) / width - 0.5
+    ys = (np.arange(height) + 0.5) / height - 0.5
+    shape = (len(factors), height, width)
+    return (np.broadcast_to(factors[:, None, None] * xs[None, None, :], shape).astype(np.float32),
+            np.broadcast_to(factors[:, None, None] * ys[None, :, None], shape).astype(np.float32))
 
 
 def _interpolation(width: int, out_width: int) -> int:

@@ -101,6 +101,16 @@ def test_backend_follows_a_subject_filling_much_of_the_frame():
     assert boxes[-1][2] > 1.15 * seq.boxes[0][2]  # it grew with the subject
 
 
+def test_backend_follows_a_small_subject_as_it_shrinks():
+    """Scale samples of a subject smaller than the scale model's size are enlarged, not averaged."""
+    seq = render_sequence(frames=40, target=40, speed=2.0, scale_change=0.7, seed=5)
+    backend = DcfBackend()
+    backend.init(seq.frames[0], seq.boxes[0])
+    boxes = [backend.update(frame)[0] for frame in seq.frames[1:]]
+    assert min(iou(box, truth) for box, truth in zip(boxes, seq.boxes[1:])) > 0.6
+    assert boxes[-1][2] < 0.85 * seq.boxes[0][2]  # it shrank with the subject
+
+
 def test_backend_scores_drop_behind_an_occluder():
     seq = render_sequence(frames=60, occlusion=(25, 45), seed=1)
     backend = DcfBackend()
