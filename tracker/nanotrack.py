@@ -34,6 +34,12 @@ class NanoTrackParams:
     context_amount: float = 0.5  # context added around the box, in units of (w + h)
     swap_rb: bool = False  # the networks were trained on BGR crops (OpenCV's TrackerNano swaps)
     velocity_gain: float = 1.0  # search centre = last centre + gain x last frame's motion (0: last centre)
+    # Size calibration at init: the network's box for the given subject on the first frame, from the
+    # centre and shifted by +-calibration_shift of the box each way, against the given size; the
+    # output sizes are corrected by that ratio to the power calibration_strength (0: off), clipped.
+    calibration_strength: float = 0.5
+    calibration_shift: float = 0.15
+    calibration_limits: tuple[float, float] = (0.7, 1.4)
 
 
 def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
@@ -137,6 +143,7 @@ class NanoTrackBackend:
         self._center = np.zeros(2)
         self._size = np.ones(2)
         self._velocity = np.zeros(2)  # the centre's motion over the last frame, pixels
+        self._calibration = np.ones(2)  # given size / the network's size for the subject (w, h)
         self._fill = (0.0, 0.0, 0.0)
         self._ready = False
 
@@ -149,6 +156,8 @@ class NanoTrackBackend:
         template = crop_square(frame, *self._center, self._context_side(), EXEMPLAR_SIZE, self._fill)
         self._head.setInput(self._features(template), "input1")
         self._ready = True
+        self._calibration = self._measure_size_calibration(frame)
+        self._size = self._size / self._calibration  # tracked in the network's own size
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
         if not self._ready:
@@ -162,8 +171,26 @@ class NanoTrackBackend:
         self._velocity = center - self._center
         self._center = center
         self._size = np.clip(size, MIN_SIZE, frame_size)
-        (cx, cy), (w, h) = self._center, self._size
+        (cx, cy), (w, h) = self._center, np.minimum(self._size * self._calibration, frame_size)
         return from_center(float(cx), float(cy), float(w), float(h)), float(np.clip(peak.score, 0, 1))
+
+    @property
+    def size_calibration(self) -> np.ndarray:
+        """The output sizes' correction (w, h) found at init: given size / the network's, softened."""
+        return self._calibration.copy()
+
+    def _measure_size_calibration(self, frame: np.ndarray) -> np.ndarray:
+        """How the given box's (w, h) relate to what the network sees as the subject's box on the
+        frame it was given on (a per-subject bias: one subject's box comes out too wide, another's
+        too short), softened by ``calibration_strength``; ones when that is 0."""
+        p = self.params
+        if p.calibration_strength <= 0:
+            return np.ones(2)
+        shifts = p.calibration_shift * np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]]) * self._size
+        side = INSTANCE_SIZE / EXEMPLAR_SIZE * self._context_side()
+        sizes = np.array([self._search(frame, self._center + shift, side).box[2:] for shift in shifts])
+        log_ratio = np.mean(np.log(self._size / np.maximum(sizes, 1.0)), axis=0)
+        return np.clip(np.exp(p.calibration_strength * log_ratio), *p.calibration_limits)
 
     def _context_side(self) -> float:
         """Side of the template crop: the box padded by ``context_amount`` (w + h), squared."""

@@ -127,3 +127,31 @@ def test_follows_a_moving_target_inside_the_subject_tracker(shared_data):
     estimates = [subject.init(seq.frames[0], seq.boxes[0], 0.0)]
     estimates += [subject.update(frame, i / 30.0) for i, frame in enumerate(seq.frames[1:], 1)]
     assert success_auc([e.box for e in estimates], seq.boxes) > 0.7
+
+
+def _size_error_on_the_first_frame(shared_data, strength: float) -> float:
+    """How far the box found on the frame the backend was given on strays from the given size."""
+    seq = render_sequence(frames=2, seed=7)
+    x, y, w, h = seq.boxes[0]
+    given = (x + 0.1 * w, y + 0.1 * h, 0.8 * w, 0.8 * h)  # a tight box: the network's sides disagree
+    backend = NanoTrackBackend(shared_data / "models", NanoTrackParams(calibration_strength=strength))
+    backend.init(seq.frames[0], given)
+    box, _ = backend.update(seq.frames[0])
+    return float(np.max(np.abs(np.log(np.array(box[2:]) / np.array(given[2:])))))
+
+
+def test_size_calibration_keeps_the_given_box_convention(shared_data):
+    assert _size_error_on_the_first_frame(shared_data, 0.0) > 0.03  # uncalibrated: the box drifts
+    assert _size_error_on_the_first_frame(shared_data, 1.0) < 0.02  # fully calibrated: it stays
+
+
+def test_size_calibration_is_clipped_and_off_at_zero_strength(shared_data):
+    seq = render_sequence(frames=2, seed=7)
+    params = NanoTrackParams(calibration_strength=8.0, calibration_limits=(0.95, 1.05))
+    backend = NanoTrackBackend(shared_data / "models", params)
+    backend.init(seq.frames[0], seq.boxes[0])
+    assert np.all((backend.size_calibration >= 0.95) & (backend.size_calibration <= 1.05))
+    assert np.any(backend.size_calibration != 1.0)
+    off = NanoTrackBackend(shared_data / "models", NanoTrackParams(calibration_strength=0.0))
+    off.init(seq.frames[0], seq.boxes[0])
+    assert np.array_equal(off.size_calibration, np.ones(2))
