@@ -35,7 +35,7 @@ log = logging.getLogger(__name__)
 
 SUMMARY_EVERY_S = 1.0
 #: The annotated video's default width: enough to review the run, and cheap to encode (a 720p
-#: frame at full size costs 3.6 ms of CPU, a 4K one several times that).
+#: frame at full size costs 3.6-5 ms of CPU, a 4K one several times that).
 DEFAULT_VIDEO_WIDTH = 640
 FEEDBACK_MODES = ("auto", "on", "off")
 

@@ -77,7 +77,7 @@ class AnnotatedVideoWriter:
 
     ``size`` is the frames' size; with ``max_width`` wider frames are shrunk before drawing, so the
     file is ``video_size(size, max_width)`` (encoding is most of the cost: a 1280x720 frame takes
-    about 3.6 ms of CPU, the same frame at 640x360 about 1.6 ms including the shrinking).
+    3.6-5 ms of CPU, the same frame at 640x360 under 2 ms including the shrinking).
     """
 
     def __init__(self, path: str | os.PathLike[str], size: tuple[int, int], fps: float,
