@@ -76,7 +76,7 @@ def test_a_bus_falling_silent_mid_run(tmp_path: Path, capsys: pytest.CaptureFixt
     monkeypatch.setattr(pipelines.cli.bus, "start_in_process",
                         lambda config=None, faults=None: real(config, Faults(silent=(1.0, 60.0))))
     out = tmp_path / "out"
-    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video", "--realtime") == 1  # outlasts 1 s
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("gimbaltrack track: error:") and "no reply" in err[-1]
     assert "told to stop" in err[-1] and not any("Traceback" in line for line in err)
