@@ -1,6 +1,7 @@
 """What the track tests share: synthetic clips, running the CLI, reading the recorded command stream."""
 from __future__ import annotations
 
+import signal
 import subprocess
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -116,5 +117,12 @@ def in_speed_range(command: SpeedCommand) -> bool:
     return all(low <= v * 10 <= high for v in (command.yaw, command.pitch, command.roll))
 
 
+def _default_sigint() -> None:
+    """A shell starts background jobs with SIGINT ignored, and Python keeps that; the signal tests
+    need it delivered whoever started pytest."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start(cmd: list[str], env: dict[str, str]) -> subprocess.Popen[str]:
-    return subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_default_sigint)
