@@ -11,8 +11,9 @@ from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
+
+from tracker.kalman import white_noise_q
 
 
 def wrap_deg(angle: float) -> float:
@@ -100,7 +101,9 @@ class DirectionFilter:
             return
         kf.F = np.array([[1.0, dt, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0],
                          [0.0, 0.0, 1.0, dt], [0.0, 0.0, 0.0, 1.0]])
-        kf.Q = Q_discrete_white_noise(dim=2, dt=dt, var=self.accel_std_dps2 ** 2, block_size=2)
+        q = np.zeros((4, 4))
+        q[:2, :2] = q[2:, 2:] = white_noise_q(dt, self.accel_std_dps2 ** 2)  # yaw, then pitch
+        kf.Q = q
         kf.predict()
         self._t = t
 
