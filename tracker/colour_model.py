@@ -8,7 +8,6 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tracker.correlation import running_average
 
 BINS = 32
 _SHIFT = 8 - int(np.log2(BINS))
@@ -31,11 +30,8 @@ class ColourModel:
 
     def learn(self, bins: np.ndarray, foreground: np.ndarray, background: np.ndarray, rate: float) -> None:
         """Fold in the pixels of ``bins`` under the boolean masks (``rate`` 1 restarts)."""
-        size = BINS**3
-        fg = np.bincount(bins[foreground], minlength=size).astype(np.float32)
-        bg = np.bincount(bins[background], minlength=size).astype(np.float32)
-        self._foreground = running_average(self._foreground, fg / max(fg.sum(), 1.0), rate)
-        self._background = running_average(self._background, bg / max(bg.sum(), 1.0), rate)
+        self._foreground = _fold(self._foreground, bins[foreground], rate)
+        self._background = _fold(self._background, bins[background], rate)
 
     def likelihood(self, bins: np.ndarray) -> np.ndarray:
         """Per pixel, P(subject | colour) in 0..1 (0 for colours never seen)."""
@@ -46,8 +42,21 @@ class ColourModel:
         return fg / (fg + bg + 1e-6)
 
 
+def _fold(histogram: np.ndarray | None, pixels: np.ndarray, rate: float) -> np.ndarray:
+    """The normalised histogram of ``pixels``' bins folded into ``histogram`` at ``rate`` (updated
+    in place: it is the model's own array; ``rate`` 1 or no histogram yet starts afresh)."""
+    counts = np.bincount(pixels, minlength=BINS**3).astype(np.float32)
+    counts *= 1.0 / max(float(pixels.size), 1.0)
+    if histogram is None or rate >= 1.0:
+        return counts
+    histogram *= 1.0 - rate
+    histogram += rate * counts
+    return histogram
+
+
 def box_response(likelihood: np.ndarray, cell: int, box_cells: tuple[int, int]) -> np.ndarray:
     """Mean likelihood of a ``box_cells`` (cols, rows) box centred on every cell of the grid."""
     rows, cols = likelihood.shape[0] // cell, likelihood.shape[1] // cell
-    cells = likelihood.reshape(rows, cell, cols, cell).mean(axis=(1, 3)).astype(np.float32)
+    cells = cv2.resize(likelihood.astype(np.float32, copy=False), (cols, rows),
+                       interpolation=cv2.INTER_AREA)  # whole cells: each one's exact mean
     return cv2.boxFilter(cells, -1, box_cells, normalize=True, borderType=cv2.BORDER_CONSTANT)

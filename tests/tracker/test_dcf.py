@@ -82,6 +82,23 @@ def test_colour_model_tells_the_subject_from_the_background():
     assert np.unravel_index(np.argmax(response), response.shape) == (4, 4)
 
 
+def test_colour_model_learns_at_its_rate():
+    """The subject's lower half takes the background's colour, learnt at rate 0.5: that colour's
+    foreground share is 0.5 x 0 + 0.5 x 0.5, against a background share of 1."""
+    patch = np.zeros((20, 20, 3), np.uint8)
+    patch[..., 0] = 200  # blue background
+    foreground = np.zeros((20, 20), bool)
+    foreground[5:15, 5:15] = True
+    patch[5:15, 5:15] = (0, 0, 220)
+    model = ColourModel()
+    model.learn(colour_index(patch), foreground, ~foreground, rate=1.0)
+    patch[10:15, 5:15] = (200, 0, 0)
+    model.learn(colour_index(patch), foreground, ~foreground, rate=0.5)
+    assert model.likelihood(colour_index(patch))[12, 12] == pytest.approx(0.25 / 1.25, rel=1e-4)
+    model.learn(colour_index(patch), foreground, ~foreground, rate=0.5)
+    assert model.likelihood(colour_index(patch))[12, 12] == pytest.approx(0.375 / 1.375, rel=1e-4)
+
+
 def test_backend_follows_a_moving_target():
     seq = render_sequence(frames=40, speed=3.0, seed=3)
     backend = DcfBackend()
