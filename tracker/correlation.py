@@ -35,7 +35,7 @@ class TranslationFilter:
         rows, cols = shape
         self.shape = shape
         self._label = fft.rfft2(gaussian_peak(shape, sigma).astype(np.float32))[..., None]
-        self._window = (np.hanning(rows)[:, None] * np.hanning(cols)[None, :])[..., None]
+        self._window = (np.hanning(rows)[:, None] * np.hanning(cols)[None, :])[..., None].astype(np.float32)
         self._regularisation = regularisation
         self._numerator: np.ndarray | None = None
         self._denominator: np.ndarray | None = None
