@@ -30,6 +30,21 @@ def test_annotate_draws_box_in_the_state_colour_without_touching_the_input() -> 
     assert out[10:60, 10:100].any()  # the text block
 
 
+def test_annotate_without_copy_draws_on_the_image_itself() -> None:
+    image = np.zeros((240, 320, 3), np.uint8)
+    out = annotate(image, _estimate(1), copy=False)
+    assert out is image and image.any()
+
+
+@pytest.mark.parametrize("max_width", [None, 80])
+def test_writing_leaves_the_callers_frame_untouched(tmp_path: Path, max_width: int | None) -> None:
+    """Full size, annotate copies; shrunk, it draws on the writer's own shrunk frame."""
+    image = np.zeros((120, 160, 3), np.uint8)
+    with AnnotatedVideoWriter(tmp_path / "a.avi", (160, 120), 30.0, max_width) as writer:
+        writer.write(image, _estimate(1), (1.0, 2.0), ["mode track"])
+    assert not image.any()
+
+
 def test_video_reads_back_with_every_frame(tmp_path: Path, frame_image: Callable[..., np.ndarray]) -> None:
     path = tmp_path / "annotated.mp4"
     with AnnotatedVideoWriter(path, (160, 120), 30.0) as writer:
