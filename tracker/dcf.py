@@ -8,6 +8,7 @@ DSST (Danelljan et al., 2014); the implementation is our own, vectorised numpy.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -186,10 +187,10 @@ class _Region:
 
     @classmethod
     def cut(cls, frame: np.ndarray, center: np.ndarray, window: np.ndarray, patch: np.ndarray) -> _Region:
-        k = max(1, int(np.min(window / (2 * patch))))
+        k = max(1, int(min(window[0] / (2 * patch[0]), window[1] / (2 * patch[1]))))
         height, width = frame.shape[:2]
-        (x0, x1), (y0, y1) = (_span(c, half + k, size, k) for c, half, size in  # + bilinear reach
-                              zip(center, window / 2.0 + 2, (width, height)))
+        (x0, x1), (y0, y1) = (_span(float(c), float(half) + 2 + k, size, k) for c, half, size in  # + bilinear reach
+                              zip(center, window / 2.0, (width, height)))
         image = frame[y0:y1, x0:x1]
         if k > 1:
             image = cv2.resize(image, ((x1 - x0) // k, (y1 - y0) // k), interpolation=cv2.INTER_AREA)
@@ -203,8 +204,8 @@ class _Region:
 
 def _span(center: float, half: float, size: int, k: int) -> tuple[int, int]:
     """Whole-pixel bounds in 0..size covering ``center`` +- ``half``, their length a multiple of k."""
-    start = int(np.clip(np.floor(center - half), 0, size - 1))
-    end = int(np.clip(np.ceil(center + half), start + 1, size))
+    start = min(max(math.floor(center - half), 0), size - 1)
+    end = min(max(math.ceil(center + half), start + 1), size)
     end = start + max(k, (end - start) // k * k)
     return (start, end) if end <= size else (max(0, size - (end - start)), size)
 
