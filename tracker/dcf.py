@@ -17,6 +17,7 @@ import numpy as np
 from tracker.boxes import Box, center, from_center
 from tracker.colour_model import ColourModel, box_response, colour_index
 from tracker.correlation import ScaleFilter, TranslationFilter
+from tracker.crops import resample_window
 from tracker.features import CELL, cell_features
 
 
@@ -134,8 +135,11 @@ class DcfBackend:
         return _Region.cut(frame, self._center, self._base_window * self._scale, np.array(self._patch_size))
 
     def _window_patch(self, region: _Region) -> np.ndarray:
+        """The window resampled to the patch size in one bilinear warp, at under 4:1 (see ``_Region``):
+        a crop then an area resize cost five times as much and scored the same (docs/tracker.md), and
+        averaging the region down further to keep bilinear under 2:1 scored lower on perturbed starts."""
         window = self._base_window * self._scale / region.k
-        return _resized_crop(region.image, region.to_region(self._center), window, self._patch_size)
+        return resample_window(region.image, region.to_region(self._center), window, self._patch_size)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
         return cell_features(_grey(patch)[None])[0]
@@ -208,19 +212,6 @@ def _span(center: float, half: float, size: int, k: int) -> tuple[int, int]:
     end = min(max(math.ceil(center + half), start + 1), size)
     end = start + max(k, (end - start) // k * k)
     return (start, end) if end <= size else (max(0, size - (end - start)), size)
-
-
-def _resized_crop(image: np.ndarray, center: tuple[float, float], size: np.ndarray, out: tuple[int, int]) -> np.ndarray:
-    """The ``size`` (w, h) window centred on ``center`` (pixel-index coordinates), resampled to
-    ``out`` in one bilinear warp; the border replicated. ``size`` stays under four times ``out``
-    (see ``_Region``); a crop then an area resize cost five times as much and scored the same
-    (docs/tracker.md), and averaging the region down further to keep bilinear under 2:1 scored
-    lower on perturbed starts."""
-    step_x, step_y = size[0] / out[0], size[1] / out[1]
-    matrix = np.array([[step_x, 0.0, center[0] + (0.5 - out[0] / 2) * step_x],
-                       [0.0, step_y, center[1] + (0.5 - out[1] / 2) * step_y]])
-    return cv2.warpAffine(image, matrix, out, flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REPLICATE)
 
 
 def _sample_offsets(size: tuple[int, int], factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 
 from tracker.boxes import Box, from_center
+from tracker.crops import resample_window
 from tracker.model_files import find_model_file
 
 EXEMPLAR_SIZE = 127  # template crop side, pixels
@@ -112,12 +113,7 @@ def crop_square(frame: np.ndarray, cx: float, cy: float, side: float, out: int,
 
     Centres are continuous coordinates (a pixel i spans [i, i + 1]); outside the frame is ``fill``.
     """
-    k = out / side
-    shift_x = (0.5 - cx) * k + out / 2 - 0.5
-    shift_y = (0.5 - cy) * k + out / 2 - 0.5
-    matrix = np.array([[k, 0.0, shift_x], [0.0, k, shift_y]], dtype=np.float64)
-    return cv2.warpAffine(frame, matrix, (out, out), flags=cv2.INTER_LINEAR,
-                          borderMode=cv2.BORDER_CONSTANT, borderValue=fill)
+    return resample_window(frame, (cx - 0.5, cy - 0.5), (side, side), (out, out), fill)
 
 
 @dataclass(frozen=True)

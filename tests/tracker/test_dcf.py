@@ -5,7 +5,7 @@ import pytest
 from tracker.boxes import iou
 from tracker.colour_model import ColourModel, box_response, colour_index
 from tracker.correlation import ScaleFilter, TranslationFilter, gaussian_peak
-from tracker.dcf import DcfBackend, _resized_crop
+from tracker.dcf import DcfBackend
 from tracker.features import CELL, CHANNELS, SIGNED_BINS, cell_features
 from tracker.synthetic import render_sequence, texture
 
@@ -145,18 +145,3 @@ def test_backend_works_on_grey_frames_and_at_the_frame_border():
     backend.init(frame, (0.0, 0.0, 30.0, 30.0))  # the window reaches outside the frame
     box, score = backend.update(frame)
     assert iou(box, (0.0, 0.0, 30.0, 30.0)) > 0.8 and score > 0.9
-
-
-@pytest.mark.parametrize("center, size", [((40.0, 30.0), (50.0, 50.0)), ((50.3, 37.8), (80.0, 40.0)),
-                                          ((20.5, 20.5), (20.0, 20.0))])
-def test_window_crop_samples_the_window_it_is_given(center: tuple[float, float], size: tuple[float, float]) -> None:
-    """On a plane x + 3 y (which bilinear sampling reproduces exactly), each output pixel holds the
-    value at its own centre within the window; pixel i of the frame is centred on coordinate i."""
-    ys, xs = np.mgrid[0:80, 0:100].astype(np.float32)
-    plane = xs + 3 * ys
-    out = (16, 12)
-    patch = _resized_crop(plane, center, np.array(size), out)
-    u = (np.arange(out[0]) + 0.5) / out[0] - 0.5
-    v = (np.arange(out[1]) + 0.5) / out[1] - 0.5
-    expected = (center[0] + u[None, :] * size[0]) + 3 * (center[1] + v[:, None] * size[1])
-    np.testing.assert_allclose(patch, expected, atol=0.05)
