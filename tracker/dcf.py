@@ -16,9 +16,10 @@ import numpy as np
 
 from tracker.boxes import Box, center, from_center
 from tracker.colour_model import ColourModel, box_response, colour_index
-from tracker.correlation import ScaleFilter, TranslationFilter
+from tracker.correlation import TranslationFilter
 from tracker.crops import resample_window
-from tracker.features import CELL, cell_features
+from tracker.features import CELL, cell_features, unit_grey
+from tracker.scale_estimator import ScaleEstimator
 
 
 @dataclass(frozen=True)
@@ -73,11 +74,7 @@ class DcfBackend:
         self._translation = TranslationFilter((int(grid[1]), int(grid[0])), sigma)
         self._colour = ColourModel()
         self._masks = self._colour_masks(cells_per_px * CELL)
-        scale_resize = np.sqrt(s.scale_area / np.prod(self._base_size))
-        self._scale_px = tuple(int(v) * CELL for v in np.maximum(np.round(self._base_size * scale_resize / CELL), 2))
-        self._scale_factors = s.scale_step ** (np.arange(s.scales) - s.scales // 2)
-        self._scale_offsets = _sample_offsets(self._scale_px, self._scale_factors)
-        self._scale_filter = ScaleFilter(s.scales, np.sqrt(s.scales) / 4)
+        self._scale_estimator = ScaleEstimator(tuple(self._base_size), s.scales, s.scale_step, s.scale_area)
         self._typical_peak = 0.0
         self._learn(self._region(frame), rate=1.0)
 
@@ -97,8 +94,7 @@ class DcfBackend:
         self._center = self._center + shift * CELL * (self._base_window * self._scale) / np.array(self._patch_size)
         region = self._region(frame)
         samples = self._scale_samples(region)
-        step = int(np.argmax(self._scale_filter.respond(samples)))
-        step = step if step <= s.scales // 2 else step - s.scales
+        step = self._scale_estimator.best_step(samples)
         if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
             step = 0
         self._scale *= s.scale_step**step
@@ -128,7 +124,7 @@ class DcfBackend:
             self._colour.learn(colour_index(patch), fg, bg, rate or s.colour_rate)
         if scale_samples is None:
             scale_samples = self._scale_samples(region)
-        self._scale_filter.learn(scale_samples, rate or s.scale_rate)
+        self._scale_estimator.learn(scale_samples, rate or s.scale_rate)
 
     def _region(self, frame: np.ndarray) -> _Region:
         """The window around the subject, cut once per position and scale; every patch comes from it."""
@@ -142,29 +138,12 @@ class DcfBackend:
         return resample_window(region.image, region.to_region(self._center), window, self._patch_size)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
-        return cell_features(_grey(patch)[None])[0]
+        return cell_features(unit_grey(patch)[None])[0]
 
     def _scale_samples(self, region: _Region) -> np.ndarray:
-        """The subject's box at every scale factor, resampled to the scale model's size in one remap
-        of the grey region, first averaged down so that the largest box is about that size (each
-        sample is then bilinear at up to 1:1, free of aliasing; per-sample area resizing took twice
-        as long and scored the same)."""
-        grey = _grey(region.image)
-        subject = self._base_size * self._scale / region.k  # region pixels
-        shrink = min(1.0, float(np.min(np.array(self._scale_px) / (subject * self._scale_factors[-1]))))
-        if shrink < 1.0:
-            size = (max(1, round(grey.shape[1] * shrink)), max(1, round(grey.shape[0] * shrink)))
-            grey = cv2.resize(grey, size, interpolation=cv2.INTER_AREA)
-        ratio = np.array([grey.shape[1] / region.image.shape[1], grey.shape[0] / region.image.shape[0]])
-        centre = (np.array(region.to_region(self._center)) + 0.5) * ratio - 0.5
-        span = subject * ratio
-        offset_x, offset_y = self._scale_offsets
-        scales, height, width = offset_x.shape
-        map_x = (offset_x * np.float32(span[0]) + np.float32(centre[0])).reshape(-1, width)
-        map_y = (offset_y * np.float32(span[1]) + np.float32(centre[1])).reshape(-1, width)
-        samples = cv2.remap(grey, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-        samples = samples.reshape(scales, height, width)
-        return cell_features(samples).reshape(len(samples), -1)
+        """The scale ladder's samples around the subject (see ``ScaleEstimator.samples``)."""
+        return self._scale_estimator.samples(region.image, region.to_region(self._center),
+                                             self._base_size * self._scale / region.k)
 
     def _colour_masks(self, patch_per_px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Foreground (the subject shrunk) and background (outside it) masks of the window patch."""
@@ -212,22 +191,6 @@ def _span(center: float, half: float, size: int, k: int) -> tuple[int, int]:
     end = min(max(math.ceil(center + half), start + 1), size)
     end = start + max(k, (end - start) // k * k)
     return (start, end) if end <= size else (max(0, size - (end - start)), size)
-
-
-def _sample_offsets(size: tuple[int, int], factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each scale sample's pixel centres relative to the subject's centre, in subject sizes:
-    x and y, each ``(scales, height, width)`` float32."""
-    width, height = size
-    xs = (np.arange(width) + 0.5) / width - 0.5
-    ys = (np.arange(height) + 0.5) / height - 0.5
-    shape = (len(factors), height, width)
-    return (np.broadcast_to(factors[:, None, None] * xs[None, None, :], shape).astype(np.float32),
-            np.broadcast_to(factors[:, None, None] * ys[None, :, None], shape).astype(np.float32))
-
-
-def _grey(patch: np.ndarray) -> np.ndarray:
-    grey = cv2.cvtColor(patch, cv2.COLOR_BGR2GRAY) if patch.ndim == 3 else patch
-    return grey.astype(np.float32) * (1.0 / 255.0)
 
 
 def _subcell(values: np.ndarray, index: int) -> float:
