@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import socket
 import sys
 import time
@@ -12,6 +13,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -39,6 +41,17 @@ def subprocess_env(can_port: int | None = None) -> dict[str, str]:
     if can_port is not None:
         env["CAN_CONFIG"] = json.dumps({"port": can_port})
     return env
+
+
+def require_ffmpeg(purpose: str) -> str:
+    """The ffmpeg program's path; fails in CI (scripts/test.sh installs it), else skips the test."""
+    found = shutil.which("ffmpeg")
+    if found is None:
+        message = f"ffmpeg is not installed (scripts/test.sh installs it): cannot test {purpose}"
+        if os.environ.get("CI"):
+            pytest.fail(message)
+        pytest.skip(message)
+    return found
 
 
 def free_udp_port() -> int:

@@ -2,8 +2,6 @@
 from __future__ import annotations
 
 import itertools
-import os
-import shutil
 import subprocess
 import threading
 from collections.abc import Callable
@@ -14,7 +12,7 @@ import pytest
 
 from pipelines.sources import SourceError, open_source
 from pipelines.sources.live import LatestFrameGrabber, LiveSource
-from tests.support import free_udp_port
+from tests.support import free_udp_port, require_ffmpeg
 
 WAIT = 10.0  # generous bound for thread hand-offs; tests never assert on durations
 
@@ -121,13 +119,7 @@ def test_camera_that_does_not_open() -> None:
 
 @pytest.fixture
 def ffmpeg() -> str:
-    path = shutil.which("ffmpeg")
-    if path is None:
-        message = "ffmpeg CLI not found (scripts/test.sh installs it): cannot test a live UDP stream"
-        if os.environ.get("CI"):
-            pytest.fail(message)
-        pytest.skip(message)
-    return path
+    return require_ffmpeg("a live UDP stream")
 
 
 @pytest.mark.slow

@@ -3,27 +3,20 @@ MPEG-TS over UDP; track follows it against the built-in simulator and reports it
 from __future__ import annotations
 
 import json
-import os
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
 from pipelines.outputs.telemetry import read_telemetry
-from tests.support import ROOT, free_udp_port
+from tests.support import ROOT, free_udp_port, require_ffmpeg
 from tests.track.helpers import DEMO, assert_stopped_at_end, decoded, run_track, speed_commands
 
 FRAMES = 90  # 3 s of the 30 fps stream
 
 
 def _ffmpeg() -> str:
-    found = shutil.which("ffmpeg")
-    if found is None:
-        if os.environ.get("CI"):
-            pytest.fail("ffmpeg is missing (the test script installs it)")
-        pytest.skip("ffmpeg is not installed")
-    return found
+    return require_ffmpeg("a live UDP stream")
 
 
 def test_tracks_a_live_udp_stream(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
