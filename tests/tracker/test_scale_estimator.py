@@ -24,7 +24,7 @@ def test_a_subject_zoomed_by_whole_steps_is_found_there(steps):
     assert estimator.best_step(estimator.samples(grown, centre, subject)) == steps
 
 
-def test_samples_of_a_large_subject_cost_no_more_than_a_small_ones():
+def test_a_large_subject_is_sampled_at_the_ladders_small_size():
     estimator = ScaleEstimator((400.0, 300.0))
     image = texture(700, 900, np.random.default_rng(4), cell=12, contrast=0.8)
     samples = estimator.samples(image, (450.0, 350.0), np.array([400.0, 300.0]))
