@@ -73,7 +73,13 @@ def test_outputs_are_complete_and_readable(demo_run: dict[str, Any]) -> None:
     assert frames == summary["frames"]
     plot = cv2.imread(str(out / "plot.png"))
     assert plot is not None and plot.shape[0] > 100 and plot.std() > 0
-    assert summary["latency_ms"]["count"] > 50 and summary["latency_ms"]["p50"] > 0
+    latency, sends = summary["latency_ms"], summary["speed_commands"]
+    # frames come faster than the keep-alive sends, so nearly every send but the final stop carries a
+    # new setpoint (a stalled loop resends one), each measured once; how many there are depends on
+    # how fast the run went
+    fresh = sends["sent"] - sends["zero_sent"]
+    assert 0.8 * fresh <= latency["count"] <= fresh and latency["count"] >= 10
+    assert 0 < latency["p50"] <= latency["p99"]
 
 
 def test_summary_angular_error_is_that_of_the_telemetry(demo_run: dict[str, Any]) -> None:
