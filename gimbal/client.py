@@ -606,3 +606,22 @@ def exit_on_signals(signals: Iterable[int] = (signal.SIGTERM,)) -> Iterator[None
     finally:
         for s, old in previous.items():
             signal.signal(s, old)
+
+
+@contextmanager
+def deferred_signals(signals: Iterable[int] = (signal.SIGINT, signal.SIGTERM)) -> Iterator[None]:
+    """Hold the given signals until the block ends, then deliver them to the handlers in place
+    before it, so a unit of work (one frame and its outputs) is done whole or not at all. Outside
+    the main thread it changes nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending: list[int] = []
+    previous = {s: signal.signal(s, lambda signum, frame: pending.append(signum)) for s in signals}
+    try:
+        yield
+    finally:
+        for s, old in previous.items():
+            signal.signal(s, old)
+        for signum in dict.fromkeys(pending):
+            signal.raise_signal(signum)

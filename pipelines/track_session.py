@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gimbal.client import GimbalClient
+from gimbal.client import GimbalClient, deferred_signals
 from gimbal.errors import GimbalError
 from gimbal.messages import ParameterPush
 from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
@@ -144,7 +144,8 @@ class TrackSession:
     def run(self) -> None:
         """Process frames until the source ends or ``max_frames``; exceptions propagate."""
         for frame in self.source:
-            self.step(frame)
+            with deferred_signals():  # a frame's telemetry, video and counts are written whole
+                self.step(frame)
             if self.options.max_frames is not None and self.frames >= self.options.max_frames:
                 self.reason = "max frames reached"
                 return

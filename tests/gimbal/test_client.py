@@ -11,7 +11,7 @@ from typing import Any
 import can
 import pytest
 
-from gimbal.client import Angles, GimbalClient, exit_on_signals
+from gimbal.client import Angles, GimbalClient, deferred_signals, exit_on_signals
 from gimbal.errors import BusError, GimbalTimeoutError, RangeError, ReturnCodeError
 from gimbal.messages import Message
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
@@ -352,6 +352,23 @@ def test_sigterm_becomes_a_clean_exit_with_the_safety_stop(channel: str, peer: S
     assert raised.value.code == 128 + signal.SIGTERM
     assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
     assert signal.getsignal(signal.SIGTERM) is previous
+
+
+def test_signals_in_a_deferred_block_arrive_once_when_it_ends() -> None:
+    done = []
+    previous = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(SystemExit) as raised:
+        with exit_on_signals(), deferred_signals():
+            signal.raise_signal(signal.SIGTERM)
+            signal.raise_signal(signal.SIGTERM)
+            done.append("the rest of the block")
+    assert done == ["the rest of the block"] and raised.value.code == 128 + signal.SIGTERM
+    assert signal.getsignal(signal.SIGTERM) is previous
+    with pytest.raises(KeyboardInterrupt):
+        with deferred_signals():
+            signal.raise_signal(signal.SIGINT)
+            done.append("finished before Ctrl-C lands")
+    assert done[-1] == "finished before Ctrl-C lands"
 
 
 def test_no_speed_command_on_exit_when_speed_was_never_used(client: GimbalClient,
