@@ -7,6 +7,7 @@ import cv2
 import numpy as np
 
 from tracker.boxes import Box, center, clip_to_frame, from_center
+from tracker.features import to_grey
 
 TEMPLATE_PX = 32
 
@@ -59,11 +60,6 @@ class AppearanceModel:
             if score > best.score:
                 best = Match((rx + mx / sx, ry + my / sy, w, h), float(score))
         return best
-
-
-def to_grey(image: np.ndarray) -> np.ndarray:
-    """A BGR image in grey (a grey image as it is)."""
-    return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
 
 
 def cut_patch(frame: np.ndarray, box: Box) -> np.ndarray:

@@ -10,8 +10,8 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from tracker.appearance import to_grey
 from tracker.boxes import Box
+from tracker.features import to_grey
 from tracker.model_files import find_model_file
 
 DETECTOR_KINDS = ("face", "person", "motion")

@@ -50,10 +50,14 @@ def cell_features(grey: np.ndarray) -> np.ndarray:
                            grey_level], axis=3).astype(np.float32)
 
 
+def to_grey(image: np.ndarray) -> np.ndarray:
+    """A BGR image in grey (a grey image as it is)."""
+    return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+
+
 def unit_grey(image: np.ndarray) -> np.ndarray:
     """A BGR or grey ``uint8`` image as grey float32 in 0..1, as ``cell_features`` takes it."""
-    grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
-    return grey.astype(np.float32) * (1.0 / 255.0)
+    return to_grey(image).astype(np.float32) * (1.0 / 255.0)
 
 
 def _neighbourhood_sum(energy: np.ndarray) -> np.ndarray:
