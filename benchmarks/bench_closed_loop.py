@@ -28,6 +28,7 @@ import cv2
 import numpy as np
 
 from gimbal.sim import SimConfig
+from machine import describe_machine
 from pipelines.closed_loop import LoopSettings, run_closed_loop
 from pipelines.control.controller import ControlConfig
 from pipelines.control.direction import DirectionFilter
@@ -117,6 +118,7 @@ def main(argv: list[str]) -> int:
     if not sequences:
         print("no 1280x720 sequence found (set GIMBALTRACK_DATA)")
         return 1
+    print(describe_machine())
     print(f"{'sequence':<14}{'latency':>8}{'ctrl':>6}{'RMS err':>10}{'mean err':>10}"
           f"{'out of view':>13}{'t centre':>10}{'overshoot':>11}")
     ok = True

@@ -10,6 +10,7 @@ import time
 from collections.abc import Callable
 
 from gimbal.framer import PacketFramer
+from machine import describe_machine
 from gimbal.messages import decode_message, message_packet
 from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl, SpeedControlReply
 from gimbal.messages.telemetry import ParameterPush
@@ -95,6 +96,7 @@ def main() -> None:
     plain, stuff = packet_bits(attitude_len)
     estimate = plain + stuff // 2
     frames = math.ceil(attitude_len / 8)
+    print(describe_machine())
     print(f"bus model: a {attitude_len}-byte packet = {frames} classic CAN frames = {plain} bits unstuffed, "
           f"{plain + stuff} with worst-case stuffing; assumed {estimate} (half the worst-case stuffing)")
     bus_rate, bus_best = BITRATE / estimate, BITRATE / plain

@@ -35,6 +35,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from machine import describe_machine  # noqa: E402
 from pipelines.cli import main  # noqa: E402
 from pipelines.outputs.telemetry import read_telemetry  # noqa: E402
 from tracker.data_paths import shared_data_dir  # noqa: E402
@@ -129,6 +130,7 @@ def main_bench() -> None:
                 fps[name].append(rate)
             print(f"round {round_}: " + ", ".join(f"{name} {values[-1]:.0f} fps" for name, values in fps.items()),
                   flush=True)
+        print(describe_machine())
         print(f"clip: {origin}, {frames} frames 1280x720 {args.codec}, subject {roi}, "
               f"cv2 threads {cv2.getNumThreads()}, {args.rounds} rounds")
         print(f"{'run':<28}{'median fps':>11}{'x decode':>10}{'per round':>14}{'p50 ms':>9}{'p95 ms':>9}"

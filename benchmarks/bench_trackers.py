@@ -15,6 +15,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from machine import describe_machine
 from tracker.backends import TrackingBackend, make_backend
 from tracker.boxes import Box
 from tracker.data_paths import shared_data_dir, shared_sequences
@@ -106,6 +107,7 @@ def _print_starts(table: dict[str, object], sequences: list[Sequence],
 
 
 def _print_table(results: dict[str, list[SequenceResult]], names: list[str]) -> None:
+    print(describe_machine())
     base = summarize(results[BASELINE])
     short = [n.split("_", 1)[-1][:8] for n in names]
     print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps "
