@@ -10,11 +10,11 @@ import time
 from collections.abc import Callable
 
 from gimbal.framer import PacketFramer
-from machine import describe_machine
 from gimbal.messages import decode_message, message_packet
 from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl, SpeedControlReply
 from gimbal.messages.telemetry import ParameterPush
 from gimbal.packet import decode_packet, encode_packet
+from machine import describe_machine
 
 BITRATE = 1_000_000
 TARGET_RATIO = 20.0
