@@ -5,7 +5,7 @@ import pytest
 from tracker.boxes import iou
 from tracker.colour_model import ColourModel, box_response, colour_index
 from tracker.correlation import ScaleFilter, TranslationFilter, gaussian_peak
-from tracker.dcf import DcfBackend
+from tracker.dcf import DcfBackend, DcfSettings
 from tracker.features import CELL, CHANNELS, SIGNED_BINS, cell_features
 from tracker.synthetic import render_sequence, texture
 
@@ -145,3 +145,29 @@ def test_backend_works_on_grey_frames_and_at_the_frame_border():
     backend.init(frame, (0.0, 0.0, 30.0, 30.0))  # the window reaches outside the frame
     box, score = backend.update(frame)
     assert iou(box, (0.0, 0.0, 30.0, 30.0)) > 0.8 and score > 0.9
+
+
+@pytest.mark.parametrize("every", [1, 3])
+def test_backend_rescales_and_learns_only_every_update_every_frames(every):
+    """Sparse updating: the scale moves, and the filters learn at ``every`` times their rate,
+    only on every ``every``-th frame after init."""
+    seq = render_sequence(frames=31, target=40, speed=1.0, scale_change=1.5, seed=6)
+    settings = DcfSettings(update_every=every)
+    backend = DcfBackend(settings)
+    backend.init(seq.frames[0], seq.boxes[0])
+    rates: list[tuple[int, float]] = []
+    learn = backend._translation.learn
+    backend._translation.learn = lambda features, rate: (rates.append((frame_number, rate)), learn(features, rate))
+    widths = [seq.boxes[0][2]]
+    for frame_number, frame in enumerate(seq.frames[1:], 1):
+        widths.append(backend.update(frame)[0][2])
+    changed = [n for n in range(1, len(widths)) if widths[n] != widths[n - 1]]
+    assert changed and all(n % every == 0 for n in changed)
+    assert [n for n, _ in rates] == list(range(every, 31, every))
+    assert all(rate == pytest.approx(every * settings.learning_rate) for _, rate in rates)
+    assert widths[-1] > 1.2 * seq.boxes[0][2]
+
+
+def test_update_every_must_be_positive():
+    with pytest.raises(ValueError, match="update_every"):
+        DcfSettings(update_every=0)
