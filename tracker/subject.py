@@ -1,6 +1,7 @@
 """SubjectTracker: a backend, a box Kalman filter, a confidence and re-acquisition."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,7 +69,7 @@ class SubjectTracker:
         self._frame_index += 1
         s = self.settings
         predicted = self._kalman.predict(timestamp)
-        box, backend_score = self._backend.update(frame)
+        box, backend_score = _usable(*self._backend.update(frame))
         patch = cut_patch(frame, box) if box is not None else None
         similarity = self._appearance.similarity(patch) if patch is not None else 0.0
         confidence = backend_score * similarity
@@ -128,3 +129,13 @@ class SubjectTracker:
         box = self._kalman.box
         return TargetEstimate(box=box, velocity=self._kalman.velocity, confidence=float(np.clip(confidence, 0, 1)),
                               state=state, timestamp=timestamp, frame_index=self._frame_index)
+
+
+def _usable(box: Box | None, score: float) -> tuple[Box | None, float]:
+    """A backend's answer with a numerical failure (a non-finite or empty box, a NaN score)
+    turned into a miss, so it never reaches the Kalman filter or the gimbal's controller."""
+    if not math.isfinite(score):
+        score = 0.0
+    if box is not None and not (all(math.isfinite(v) for v in box) and box[2] > 0 and box[3] > 0):
+        return None, 0.0
+    return box, score

@@ -80,7 +80,9 @@ class Controller(Protocol):
 
 
 def _tracking(estimate: TargetEstimate | None) -> bool:
-    return estimate is not None and estimate.state is TrackState.TRACKING
+    """A detection to steer by: tracked, with a finite centre (a NaN would poison the filter)."""
+    return (estimate is not None and estimate.state is TrackState.TRACKING
+            and all(math.isfinite(v) for v in estimate.center))
 
 
 class RateController:

@@ -5,7 +5,10 @@ import math
 
 
 def clamp(value: float, limit: float) -> float:
-    """``value`` clamped into [-limit, limit]."""
+    """``value`` clamped into [-limit, limit]. NaN raises ``ValueError``: ``min``/``max`` would
+    quietly turn it into +limit, a full-speed command from a number that means nothing."""
+    if math.isnan(value):
+        raise ValueError("cannot clamp NaN")
     return max(-limit, min(limit, value))
 
 

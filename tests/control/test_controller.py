@@ -196,3 +196,17 @@ def test_the_first_detection_is_acted_on_within_the_acceleration_limit():
     assert first.pitch_dps == 0.0 and first.roll_dps == 0.0
     with pytest.raises(ValueError):
         ControlConfig(first_step_s=0.0)
+
+
+@pytest.mark.parametrize("name", ["pid", "p"])
+def test_a_nan_box_is_never_steered_by(name):
+    """min/max turn NaN into the limit: a NaN centre once drove these controllers to full speed."""
+    ctl = make_controller(name, camera=CAM)
+    centred = (310.0, 170.0, 20.0, 20.0)  # the image centre: nothing to correct
+    cmds = []
+    for i in range(60):
+        box = (float("nan"),) * 4 if 10 <= i < 13 else centred
+        t = i / 30
+        cmds.append(ctl.update(TargetEstimate(box, (0, 0), 0.9, TrackState.TRACKING, t, i), (0.0, 0.0), t))
+    rates = np.array([(c.yaw_dps, c.pitch_dps) for c in cmds])
+    assert np.isfinite(rates).all() and np.abs(rates).max() < 1.0

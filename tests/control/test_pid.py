@@ -70,3 +70,14 @@ def test_reset_and_bad_arguments():
     with pytest.raises(ValueError):
         Pid(1.0, output_limit=0.0)
     assert math.isinf(Pid(1.0).output_limit)
+
+
+def test_nan_is_refused_not_clamped_to_the_limit():
+    from pipelines.control.limits import limit_rate
+    from pipelines.control.pid import clamp
+
+    with pytest.raises(ValueError):
+        clamp(float("nan"), 10.0)
+    with pytest.raises(ValueError):
+        Pid(1.0, 1.0, output_limit=10.0)(float("nan"), 0.1)
+    assert limit_rate(20.0, float("nan"), 100.0, 100.0, 0.1) == pytest.approx(10.0)  # towards 0

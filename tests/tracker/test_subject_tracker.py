@@ -96,3 +96,35 @@ def test_nano_follows_and_is_default_with_model_files(shared_data):
     seq = render_sequence(frames=50, seed=7)
     estimates = _track("default", seq, models)
     assert success_auc([e.box for e in estimates], seq.boxes) > 0.6
+
+
+class _GlitchingBackend:
+    """A backend that follows the rendered subject but answers NaN on frames 10 and 11."""
+
+    name = "glitching"
+
+    def __init__(self, boxes):
+        self._boxes = boxes
+        self._frame = 0  # the sequence's frame, also across re-initialisations
+
+    def init(self, frame, box):
+        pass
+
+    def update(self, frame):
+        self._frame += 1
+        if self._frame in (10, 11):
+            return (float("nan"), 5.0, float("inf"), 10.0), float("nan")
+        return tuple(float(v) for v in self._boxes[self._frame]), 0.9
+
+
+def test_a_backends_numerical_failure_is_a_miss_not_a_measurement():
+    from tracker.subject import SubjectTracker
+
+    seq = render_sequence(frames=30, seed=4)
+    subject = SubjectTracker("glitching", _GlitchingBackend(seq.boxes))
+    subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    estimates = [subject.update(f, i / FPS) for i, f in enumerate(seq.frames[1:], 1)]
+    assert all(np.isfinite(e.box).all() and np.isfinite(e.velocity).all() and np.isfinite(e.confidence)
+               for e in estimates)
+    assert [e.state for e in estimates[9:11]] == [TrackState.SEARCHING] * 2
+    assert estimates[-1].state is TrackState.TRACKING and iou(estimates[-1].box, seq.boxes[-1]) > 0.7
