@@ -40,8 +40,8 @@ class _Setpoint:
 
 
 def _clamped_raw(value: float, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
-        raise RangeError(f"{name}={value!r} is not a number")
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise RangeError(f"{name}={value!r} is not a finite number")
     return to_raw(max(-MAX_SPEED_DPS, min(MAX_SPEED_DPS, value)), name)
 
 
@@ -103,15 +103,17 @@ class SpeedStreamer:
             return list(self._latencies)
 
     def stop(self) -> None:
-        """Stop streaming, then send zero speed and release control (bit 7 clear). Idempotent."""
-        if self._stopped:
-            return
+        """Stop streaming, then send zero speed and release control (bit 7 clear). Idempotent, and
+        every call returns only after the thread's last send, so a call repeated after an
+        interrupted one (Ctrl-C during the join) never lets a setpoint follow the stop."""
+        first = not self._stopped
         self._stopped = True
         self._halt.set()
         self._wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join()
-        self._client.stop_and_release()
+        if first:
+            self._client.stop_and_release()
 
     def halt(self, error: BaseException) -> None:
         """Stop streaming because the bus is lost (called by the client before its best-effort
@@ -142,8 +144,8 @@ class SpeedStreamer:
                     self._halt.wait(last_send + min_gap - now)
                 else:
                     self._wake.wait(next_tick - now)
-        except (GimbalError, can.CanError) as exc:
-            if self._halt.is_set():
+        except Exception as exc:  # the bus's errors, and any other: never end without a word
+            if self._halt.is_set() and isinstance(exc, (GimbalError, can.CanError)):
                 return  # stop() or halt() raced with a send: nothing is lost
             self.error = exc
             self._halt.set()

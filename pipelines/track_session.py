@@ -20,6 +20,7 @@ from gimbal.messages import ParameterPush
 from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
 from pipelines.control import AttitudeHistory, CameraModel, ControlConfig, make_controller
 from pipelines.outputs.annotated_video import BackgroundVideoWriter
+from pipelines.outputs.can_log import CanLogWriter
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.plot import write_timeseries_png
 from pipelines.outputs.summary import write_summary
@@ -93,8 +94,9 @@ class TrackSession:
     """One tracking run against an open source and an open gimbal client."""
 
     def __init__(self, options: TrackOptions, source: FrameSource, client: GimbalClient,
-                 bus_description: str) -> None:
+                 bus_description: str, can_log: CanLogWriter | None = None) -> None:
         self.options = options
+        self.can_log = can_log  # the bus's log: its write failure ends the run (OSError)
         self.source = source
         self.client = client
         self.bus_description = bus_description
@@ -167,6 +169,8 @@ class TrackSession:
         state = estimate.state.value if estimate is not None else "acquiring"
         self.states[state] += 1
         self._write_frame(frame, stamp, state, estimate, command)
+        if self.can_log is not None and self.can_log.error is not None:
+            raise OSError(f"cannot write the CAN log {self.can_log.path}: {self.can_log.error}")
         self._progress.update(self.frames, lambda: f"{state:<9} yaw {command.yaw_dps:+6.1f} "
                                                    f"pitch {command.pitch_dps:+6.1f} deg/s")
         if time.monotonic() - self._last_summary >= SUMMARY_EVERY_S:

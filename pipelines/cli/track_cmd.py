@@ -128,15 +128,16 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                 where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
                          " ".join(str(v) for v in (args.interface or "python-can's configured bus",
                                                    args.channel) if v))
-                session = _session(options, source, client, where)
+                session = _session(options, source, client, where, can_log)
                 return _run(session, args)
         finally:
             can_log.stop()
 
 
-def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, where: str) -> TrackSession:
+def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, where: str,
+             can_log: CanLogWriter) -> TrackSession:
     try:
-        session = TrackSession(options, source, client, where)
+        session = TrackSession(options, source, client, where, can_log)
     except (ValueError, FileNotFoundError, OSError) as exc:
         raise CliError(str(exc)) from None
     try:
@@ -164,7 +165,7 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
         session.finish("source failed", str(exc))
         raise CliError(f"{exc} (outputs so far are in {session.options.out_dir})", exit_code=1) from None
     except (GimbalError, OSError) as exc:
-        session.finish("gimbal or bus failed", str(exc))
+        session.finish("gimbal or bus failed" if isinstance(exc, GimbalError) else "output failed", str(exc))
         raise CliError(f"{exc} (the gimbal was told to stop; outputs so far are in "
                        f"{session.options.out_dir})", exit_code=1) from None
     except Exception as exc:  # a bug: keep the outputs and stop the gimbal, then let it show

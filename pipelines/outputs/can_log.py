@@ -21,7 +21,9 @@ ECHO_WINDOW_S = 0.5  # how long a sent frame may take to come back as an echo
 class CanLogWriter(can.Listener):
     """A thread-safe ``can.Listener`` writing every message it is given; attach it to a ``can.Notifier``
     or let a ``LoggingBus`` feed it. The direction written is the message's own ``is_rx``; every line
-    names ``channel`` (one log holds one bus)."""
+    names ``channel`` (one log holds one bus). A failed write (a full disk) never raises into the
+    sender, whose frames, stop commands included, must still go out: logging stops and ``error``
+    holds the failure for the owner to report."""
 
     def __init__(self, path: str | os.PathLike[str], channel: str = "can0") -> None:
         self.path = path
@@ -31,6 +33,7 @@ class CanLogWriter(can.Listener):
         self._lock = threading.Lock()
         self._stopped = False
         self.count = 0
+        self.error: OSError | None = None
 
     def on_message_received(self, msg: can.Message) -> None:
         with self._lock:
@@ -38,16 +41,28 @@ class CanLogWriter(can.Listener):
                 return
             line = copy.copy(msg)
             line.channel = self.channel
-            self._writer.on_message_received(line)
-            self._file.flush()
+            try:
+                self._writer.on_message_received(line)
+                self._file.flush()
+            except OSError as exc:
+                self.error = exc
+                self._close()
+                return
             self.count += 1
 
     def stop(self) -> None:
         """Close the file; messages arriving later are ignored."""
         with self._lock:
-            if not self._stopped:
-                self._stopped = True
-                self._writer.stop()
+            self._close()
+
+    def _close(self) -> None:
+        if self._stopped:
+            return
+        self._stopped = True
+        try:
+            self._writer.stop()
+        except OSError as exc:  # the last flush failed: what reached the disk stays readable
+            self.error = self.error or exc
 
 
 class LoggingBus(can.BusABC):

@@ -166,3 +166,56 @@ def test_a_lost_receive_side_halts_the_streamer_and_stops_the_gimbal(channel: st
         time.sleep(0.1)  # nothing moves the gimbal after the stop
         assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
     bus.shutdown()
+
+
+def test_an_unexpected_failure_in_the_thread_stops_the_gimbal_and_is_raised(
+        client: GimbalClient, peer: ScriptedPeer, monkeypatch: pytest.MonkeyPatch) -> None:
+    streamer = client.speed_streamer()
+    streamer.set(5, 5)
+    peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 50)
+
+    def broken() -> None:
+        raise RuntimeError("a bug in the keep-alive")
+
+    monkeypatch.setattr(streamer, "_tick", broken)
+    streamer.set(6, 6)  # wakes the thread, which fails on its next send
+    peer.wait_for(SpeedControl, where=lambda m: m.ctrl_byte == RELEASE[3])
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+    assert isinstance(streamer.error, RuntimeError) and not streamer.running
+    with pytest.raises(BusError, match="a bug in the keep-alive"):
+        streamer.set(1, 1)
+
+
+def test_a_stop_repeated_after_an_interrupted_one_waits_for_the_last_send(
+        client: GimbalClient, peer: ScriptedPeer, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C during stop()'s join while the thread is in a (slow) send: the repeated stop() must
+    wait for that send, so that the client's stop that follows is the last word on the bus."""
+    import threading
+
+    streamer = client.speed_streamer(max_age=60.0)
+    streamer.set(5, 5)
+    peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 50)
+    real_tick, in_tick = streamer._tick, threading.Event()
+
+    def slow_tick():  # type: ignore[no-untyped-def]
+        in_tick.set()
+        time.sleep(0.3)
+        return real_tick()
+
+    monkeypatch.setattr(streamer, "_tick", slow_tick)
+    streamer.set(6, 6)
+    assert in_tick.wait(5.0)
+    thread = streamer._thread
+    real_join = thread.join
+
+    def interrupted_join(timeout: float | None = None) -> None:
+        monkeypatch.setattr(thread, "join", real_join)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(thread, "join", interrupted_join)
+    with pytest.raises(KeyboardInterrupt):
+        streamer.stop()
+    streamer.stop()
+    client.safety_stop()  # what the client's close() does next
+    time.sleep(0.5)  # a send still under way would land by now
+    assert speed_messages(peer)[-3:] == [(60, 0, 60, 0x88), ZERO, RELEASE]

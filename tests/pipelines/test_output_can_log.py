@@ -98,3 +98,22 @@ def test_a_bus_that_echoes_our_frames_logs_and_returns_each_frame_once(tmp_path)
     peer.shutdown()
     logged = list(can.LogReader(path))
     assert [(m.arbitration_id, m.is_rx) for m in logged] == [(0x223, False)] * 3 + [(0x222, True)]
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_failed_write_never_stops_the_frames(tmp_path: Path, channel: str) -> None:
+    """A full disk: the frames (a stop command among them) still go out whole; the log records why
+    it stopped, for its owner to report."""
+    path = tmp_path / "can.log"
+    path.symlink_to("/dev/full")
+    log = CanLogWriter(path)
+    peer = can.Bus(interface="virtual", channel=channel)
+    bus = LoggingBus(can.Bus(interface="virtual", channel=channel), log)
+    try:
+        for i in range(3):
+            bus.send(_message(0x223, bytes([i])))
+        assert [bytes(peer.recv(5.0).data) for _ in range(3)] == [b"\x00", b"\x01", b"\x02"]
+    finally:
+        bus.shutdown()
+        peer.shutdown()
+    assert log.error is not None and log.error.errno == 28 and log.count == 0

@@ -90,6 +90,29 @@ def test_a_bus_falling_silent_mid_run(tmp_path: Path, capsys: pytest.CaptureFixt
     assert any(not c.zero for c in speed_commands(records))
 
 
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_can_log_that_cannot_be_written_ends_the_run_with_the_gimbal_stopped(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    sims = []
+    real = gimbal.sim.start_in_process
+
+    def keep(config=None, faults=None):  # type: ignore[no-untyped-def]
+        bus, sim = real(config, faults)
+        sims.append(sim)
+        return bus, sim
+
+    monkeypatch.setattr(pipelines.cli.bus, "start_in_process", keep)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "can.log").symlink_to("/dev/full")  # the disk is full from the first frame on
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
+    _one_line_error(capsys, "cannot write the CAN log", "told to stop")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "output failed" and summary["frames"] >= 1
+    state = sims[0].state()
+    assert state.commands["speed_control"] >= 3 and not state.speed_control  # taken, then released
+
+
 def _wait_for(predicate, timeout: float, what: str) -> None:  # type: ignore[no-untyped-def]
     assert wait_until(predicate, timeout, step=0.05), f"timed out waiting for {what}"
 
