@@ -588,8 +588,21 @@ class GimbalClient:
         return recording
 
 
+#: What ends a process politely besides Ctrl-C: ``kill``, a closed terminal (SIGHUP), Ctrl-\ (SIGQUIT).
+TERMINATING_SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP", "SIGQUIT")
+                            if hasattr(signal, name))
+
+
+def signal_exit_name(code: object) -> str:
+    """The signal behind an ``exit_on_signals`` exit status (143 -> ``SIGTERM``)."""
+    try:
+        return signal.Signals(int(code) - 128).name  # type: ignore[call-overload]
+    except (TypeError, ValueError):
+        return "a signal"
+
+
 @contextmanager
-def exit_on_signals(signals: Iterable[int] = (signal.SIGTERM,)) -> Iterator[None]:
+def exit_on_signals(signals: Iterable[int] = TERMINATING_SIGNALS) -> Iterator[None]:
     """Turn the given signals into ``SystemExit(128 + signum)`` in the main thread, so ``with
     GimbalClient(...)`` blocks unwind and send the safety stop (Ctrl-C already raises
     ``KeyboardInterrupt``). Outside the main thread it changes nothing."""
@@ -609,7 +622,7 @@ def exit_on_signals(signals: Iterable[int] = (signal.SIGTERM,)) -> Iterator[None
 
 
 @contextmanager
-def deferred_signals(signals: Iterable[int] = (signal.SIGINT, signal.SIGTERM)) -> Iterator[None]:
+def deferred_signals(signals: Iterable[int] = (signal.SIGINT, *TERMINATING_SIGNALS)) -> Iterator[None]:
     """Hold the given signals until the block ends, then deliver them to the handlers in place
     before it, so a unit of work (one frame and its outputs) is done whole or not at all. Outside
     the main thread it changes nothing."""

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from gimbal.client import GimbalClient, exit_on_signals
+from gimbal.client import GimbalClient, exit_on_signals, signal_exit_name
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from pipelines.acquire import PICKS, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
@@ -106,7 +106,7 @@ def _options(args: argparse.Namespace) -> TrackOptions:
 
 def run_track(args: argparse.Namespace) -> int:
     options = _options(args)
-    # SIGTERM unwinds like Ctrl-C from here on: every ``with`` below stops the gimbal on the way out
+    # SIGTERM, SIGHUP and SIGQUIT unwind like Ctrl-C from here on: every ``with`` below stops the gimbal on the way out
     with exit_on_signals():
         return _open_and_run(options, args)
 
@@ -159,7 +159,7 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
         _report(session.finish("interrupted (SIGINT)"), args)
         return EXIT_INTERRUPTED
     except SystemExit as exc:
-        _report(session.finish("terminated (SIGTERM)"), args)
+        _report(session.finish(f"terminated ({signal_exit_name(exc.code)})"), args)
         return int(exc.code or 1)
     except SourceError as exc:
         session.finish("source failed", str(exc))

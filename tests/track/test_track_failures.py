@@ -120,6 +120,7 @@ def _wait_for(predicate, timeout: float, what: str) -> None:  # type: ignore[no-
 @pytest.mark.parametrize("signum, code, status", [
     (signal.SIGINT, 130, "interrupted (SIGINT)"),
     (signal.SIGTERM, 143, "terminated (SIGTERM)"),
+    (signal.SIGHUP, 129, "terminated (SIGHUP)"),  # the terminal closed
 ])
 def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signum: int, code: int,
                                                       status: str) -> None:
