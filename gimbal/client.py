@@ -416,6 +416,17 @@ class GimbalClient:
             raise ValueError(f"{message.NAME} wants a reply; use request()")
         self._transmit(message, self._encode(message)[1])
 
+    def send_best_effort(self, message: Message) -> None:
+        """Send a host push even once the receive side is lost: for the zero push that ends a
+        joystick or dial stream (those pushes have no timeout on the gimbal). A failure is
+        logged, never raised."""
+        if message.REPLY is not None:
+            raise ValueError(f"{message.NAME} wants a reply; use request()")
+        try:
+            self.transport.send(self._encode(message)[1])
+        except (GimbalError, can.CanError, OSError) as exc:
+            log.warning("%s not sent: %s", message.NAME, exc)
+
     def _ask(self, message: Message, reply_type: type[R]) -> R:
         reply = self.request(message)
         if not isinstance(reply, reply_type):

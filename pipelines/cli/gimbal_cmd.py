@@ -83,7 +83,8 @@ def _for_print(args: argparse.Namespace, names: tuple[str, ...], what: str) -> N
 
 
 def _repeat(send: Callable[[], None], stop: Callable[[], None], duration: float) -> None:
-    """Send a push at STREAM_HZ for ``duration`` s, then its zero, even when interrupted."""
+    """Send a push at STREAM_HZ for ``duration`` s, then its zero, even when interrupted or when
+    the bus fails (``stop`` is best effort)."""
     end = time.monotonic() + duration
     try:
         while True:
@@ -441,9 +442,11 @@ COMMANDS = [
     Command("joystick", "external joystick push (raw values)",
             lambda a: [JoystickPush(pitch_speed=a.pitch, roll_speed=a.roll, yaw_speed=a.yaw)],
             _ok(lambda c, a: _repeat(lambda: c.joystick(a.yaw, a.pitch, a.roll),
-                                     lambda: c.joystick(0, 0, 0), a.duration)), _joystick_args),
+                                     lambda: c.send_best_effort(JoystickPush()), a.duration)),
+            _joystick_args),
     Command("dial", "external dial push (raw value)", lambda a: [DialPush(dial_speed=a.speed)],
-            _ok(lambda c, a: _repeat(lambda: c.dial(a.speed), lambda: c.dial(0), a.duration)),
+            _ok(lambda c, a: _repeat(lambda: c.dial(a.speed), lambda: c.send_best_effort(DialPush()),
+                                     a.duration)),
             _dial_args),
     Command("photo", "take a photo", _camera_action("take-photo"), _ok(lambda c, a: c.photo())),
     Command("record", "start or stop recording",

@@ -398,3 +398,21 @@ def test_an_unconfigured_bus_is_a_bus_error(monkeypatch: pytest.MonkeyPatch, tmp
         monkeypatch.delenv(name, raising=False)
     with pytest.raises(BusError, match="cannot open the CAN bus"):
         GimbalClient()
+
+
+def test_the_zero_push_still_goes_out_once_the_receive_side_is_lost(channel: str, peer: ScriptedPeer) -> None:
+    """Joystick and dial pushes have no timeout on the gimbal: their zero must not be refused
+    because the bus stopped answering."""
+    bus = FlakyBus(channel=channel)
+    with GimbalClient(bus, timeout=0.2) as gimbal:
+        gimbal.joystick(5000, 0)
+        bus.fail_recv = True
+        poll(lambda: not gimbal.alive)
+        with pytest.raises(BusError):
+            gimbal.joystick(5000, 0)
+        gimbal.send_best_effort(JoystickPush())
+        poll(lambda: len(peer.messages(JoystickPush)) == 2)
+        assert [m.yaw_speed for m in peer.messages(JoystickPush)] == [5000, 0]
+        bus.fail_send = True
+        gimbal.send_best_effort(JoystickPush())  # logged, not raised
+    bus.shutdown()
