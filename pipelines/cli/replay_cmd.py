@@ -17,10 +17,13 @@ from typing import Any, TextIO
 import can
 
 from gimbal.client import exit_on_signals, stop_messages
+from gimbal.errors import PayloadError, RangeError
+from gimbal.framer import Dropped, PacketFramer
 from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
-from gimbal.messages import message_packet
+from gimbal.messages import decode_message, message_packet
 from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
-from gimbal.transport import CanTransport
+from gimbal.packet import Packet
+from gimbal.transport import CanTransport, packet_frames
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
 from pipelines.cli.decode_cmd import _close, _open_log, iter_log_frames
@@ -37,9 +40,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "replay", help="play a recorded CAN log back: decoded packets, a summary, optionally onto a bus",
         description="Play a recorded session's CAN traffic (the can.log 'gimbaltrack track' writes, or "
         "any log python-can reads) through the DJI R SDK decoder: one line per packet (time, direction, "
-        "name, key fields in degrees) and a summary. With -i the host->gimbal frames are sent onto that "
+        "name, key fields in degrees) and a summary. With -i the host->gimbal packets are sent onto that "
         "bus at their recorded times ('-i sim': the built-in simulated gimbal, whose final state is "
-        "printed). An interrupted replay onto a bus ends with zero speed and control released.",
+        "printed); only whole packets of the document with every value in its range are sent, the "
+        "others are counted in the summary. An interrupted replay onto a bus ends with zero speed "
+        "and control released.",
         epilog="examples:\n  gimbaltrack replay out/track/can.log\n"
         "  gimbaltrack replay out/track/can.log --json | jq .\n"
         "  gimbaltrack replay out/track/can.log -i sim --speed 4\n"
@@ -68,6 +73,7 @@ class ReplaySummary:
     last_speed: dict[str, int] | None = None
     frames: int = 0
     frames_sent: int = 0
+    not_sent: Counter[str] = field(default_factory=Counter)  # host packets held back, by reason
     echoes: int = 0  # host frames the bus looped back, skipped
     first_t: float | None = None
     last_t: float | None = None
@@ -97,7 +103,8 @@ class ReplaySummary:
 
     def as_dict(self) -> dict[str, Any]:
         last = self.last_speed
-        return {"frames": self.frames, "frames_sent": self.frames_sent, "echoes_skipped": self.echoes,
+        return {"frames": self.frames, "frames_sent": self.frames_sent, "packets_not_sent": dict(self.not_sent),
+                "echoes_skipped": self.echoes,
                 "duration_s": None if self.first_t is None else self.last_t - self.first_t,
                 "packets": dict(self.packets), "errors": dict(self.errors), "out_of_range": self.out_of_range,
                 "speed_commands": len(self.speed_times), "speed_rate_hz": self.speed_rate_hz(),
@@ -113,6 +120,9 @@ class ReplaySummary:
         rate = d["speed_rate_hz"]
         lines = [f"replayed {d['frames']} CAN frames over {d['duration_s'] or 0.0:.2f} s"
                  + (f", sent {d['frames_sent']} host->gimbal frames" if d["frames_sent"] else "")
+                 + (f", held back {sum(self.not_sent.values())} host packets ("
+                    + ", ".join(f"{n} {c}" for n, c in sorted(self.not_sent.items())) + ")"
+                    if self.not_sent else "")
                  + (f" ({self.echoes} looped-back host frames skipped)" if self.echoes else ""),
                  "packets: " + (", ".join(f"{n} {c}" for n, c in sorted(self.packets.items())) or "none"),
                  f"speed commands: {d['speed_commands']}"
@@ -150,6 +160,44 @@ def _field(name: str, value: Any, record: Record) -> str:
     if name == "return_code":
         return f"rc={value} ({record.get('return_code_meaning', '?')})"
     return f"{name}={value}"
+
+
+class _HostPackets:
+    """Host frames bound for a bus, held until they make up a whole packet that decodes to a
+    message of the document with every value in its range: only such packets go out (their own
+    bytes, cut into frames as recorded), so a foreign or corrupt log never puts an out-of-range
+    value or a broken packet on a gimbal's bus."""
+
+    def __init__(self, summary: ReplaySummary) -> None:
+        self._framer = PacketFramer()
+        self._summary = summary
+
+    def feed(self, data: bytes) -> list[bytes]:
+        """The raw bytes of each packet ``data`` completes that may be sent."""
+        ready = []
+        for item in self._framer.feed(data):
+            reason = item.reason if isinstance(item, Dropped) else _refusal(item)
+            if reason is None:
+                ready.append(item.raw)
+            else:
+                self._summary.not_sent[reason] += 1
+        return ready
+
+    def finish(self) -> None:
+        """End of the log: a packet left incomplete is counted, never sent."""
+        for dropped in self._framer.flush():
+            self._summary.not_sent[dropped.reason] += 1
+
+
+def _refusal(packet: Packet) -> str | None:
+    """Why a framed host packet must not be sent, or None."""
+    try:
+        decode_message(packet).validate()
+    except RangeError:
+        return "out_of_range"
+    except PayloadError:
+        return "undecodable"
+    return None
 
 
 class _Pacer:
@@ -220,6 +268,7 @@ def _settled(sim: Any) -> Any:
 def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | None, out: TextIO) -> None:
     decoder = LogDecoder(args.tx_id, args.rx_id)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
+    outgoing = _HostPackets(summary)
     skip_echoes = _marks_sent_frames(args.log, args.tx_id)
     with closing(iter_log_frames(args.log, "replay")) as frames:
         for frame in frames:
@@ -232,9 +281,11 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
             if pacer is not None:
                 pacer.wait(frame.timestamp)
             if bus is not None and frame.arbitration_id == args.tx_id and not frame.is_extended_id:
-                _send(bus, frame)
-                summary.frames_sent += 1
+                for raw in outgoing.feed(bytes(frame.data)):
+                    summary.frames_sent += _send(bus, raw, args.tx_id)
             _emit(decoder.feed_frame(frame), summary, args.json, out)
+    if bus is not None:
+        outgoing.finish()
     _emit(decoder.finish(summary.last_t), summary, args.json, out)
 
 
@@ -250,23 +301,25 @@ def _marks_sent_frames(path: str, tx_id: int) -> bool:
         _close(reader)
 
 
-def _send(bus: can.BusABC, frame: can.Message) -> None:
-    message = can.Message(arbitration_id=frame.arbitration_id, data=bytes(frame.data), is_extended_id=False)
+def _send(bus: can.BusABC, raw: bytes, tx_id: int) -> int:
+    """Send one packet's frames; returns how many."""
+    frames = packet_frames(raw, tx_id)
     try:
-        bus.send(message, timeout=0.05)
+        for frame in frames:
+            bus.send(frame, timeout=0.05)
     except can.CanError as exc:
         raise CliError(f"the bus refused a frame: {exc}", exit_code=1) from None
+    return len(frames)
 
 
 def _stop_gimbal(bus: can.BusABC, tx_id: int, rx_id: int) -> None:
     """Best effort: zero speed, then zero with control released."""
     transport = CanTransport(bus, tx_id, rx_id)
     for offset, message in enumerate(stop_messages()):
-        try:
+        try:  # the release is tried even when the zero failed
             transport.send(message_packet(message, STOP_SEQ + offset))
         except (can.CanError, OSError) as exc:
             print(f"gimbaltrack replay: warning: could not send the stop: {exc}", file=sys.stderr)
-            return
 
 
 def _emit(records: list[Record], summary: ReplaySummary, as_json: bool, out: TextIO) -> None:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import struct
 import threading
 import time
 import uuid
@@ -10,6 +11,8 @@ from pathlib import Path
 import can
 import pytest
 
+from gimbal.packet import Packet, encode_packet
+from gimbal.transport import packet_frames
 from pipelines.cli import main
 from tests.track.helpers import decoded, make_clip, roi_at, run_track, speed_commands
 
@@ -101,3 +104,28 @@ def test_bad_files(tmp_path: Path, capsys: pytest.CaptureFixture[str], content: 
     assert main(["replay", str(path)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("gimbaltrack replay: error:") and words in err
+
+
+def test_onto_a_bus_only_whole_in_range_packets_go_out(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A foreign log: out-of-range speeds, a command the document does not define and a packet cut
+    short are decoded and reported, but never sent to a gimbal."""
+    def speed(yaw: int, ctrl: int, seq: int) -> bytes:
+        return encode_packet(Packet.command(0x0E, 0x01, struct.pack("<hhhB", yaw, 0, 0, ctrl), seq))
+
+    packets = [speed(300, 0x88, 1), speed(5000, 0x88, 2), speed(-32768, 0x88, 3),
+               encode_packet(Packet.command(0x0E, 0x7F, b"\x00", 4)), speed(0, 0x08, 5), speed(200, 0x88, 6)[:12]]
+    log = tmp_path / "foreign.log"
+    with log.open("w") as file:
+        writer = can.CanutilsLogWriter(file, channel="can0")
+        for i, raw in enumerate(packets):
+            for frame in packet_frames(raw, 0x223):
+                frame.timestamp, frame.is_rx = 1000.0 + 0.01 * i, False
+                writer.on_message_received(frame)
+        writer.stop()
+    channel = f"replay-{uuid.uuid4().hex}"
+    with can.Bus(interface="virtual", channel=channel) as listener:
+        assert main(["replay", str(log), "-i", "virtual", "-c", channel, "--json"]) == 0
+        received = b"".join(bytes(m.data) for m in iter(lambda: listener.recv(0.2), None))
+    assert received == packets[0] + packets[4]
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])["summary"]
+    assert summary["packets_not_sent"] == {"out_of_range": 2, "undecodable": 1, "truncated": 1}
