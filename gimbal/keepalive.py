@@ -27,6 +27,8 @@ log = logging.getLogger(__name__)
 
 MAX_SPEED_DPS = 360.0
 MIN_RATE_HZ = 4.0  # at least two sends inside the gimbal's 0.5 s window
+MAX_RATE_HZ = 50.0  # public drivers use 10-50 Hz; a new setpoint may go out at twice the rate, and
+# each reply (a few ms) must be back by the next send, half a period later at the least
 
 
 @dataclass
@@ -57,8 +59,9 @@ class SpeedStreamer:
 
     def __init__(self, client: GimbalClient, rate_hz: float = 25.0, max_age: float = 0.3, *,
                  max_missed_replies: int = 10, clock: Callable[[], float] = time.monotonic) -> None:
-        if not rate_hz >= MIN_RATE_HZ:
-            raise ValueError(f"rate_hz must be at least {MIN_RATE_HZ} (a command lasts 0.5 s)")
+        if not MIN_RATE_HZ <= rate_hz <= MAX_RATE_HZ:
+            raise ValueError(f"the keep-alive rate must be {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz (a command "
+                             f"lasts 0.5 s; replies must be back by the next send), not {rate_hz:g}")
         if not max_age > 0 or max_missed_replies < 1:
             raise ValueError("max_age must be > 0 and max_missed_replies >= 1")
         self.rate_hz = rate_hz

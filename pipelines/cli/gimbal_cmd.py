@@ -18,6 +18,7 @@ from typing import Any
 from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, FIRST_SEQ,
                            GimbalClient, exit_on_signals, lookup, position_message, speed_message)
 from gimbal.errors import GimbalError, GimbalTimeoutError, RangeError
+from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.messages import Message, message_packet
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_STATES, DialPush, FocusCalibration,
@@ -175,7 +176,8 @@ def _speed_args(p: argparse.ArgumentParser) -> None:
     for axis in ("yaw", "pitch", "roll"):
         p.add_argument(f"--{axis}", type=float, default=0.0, help=f"{axis} speed in °/s (-360..360)")
     p.add_argument("--duration", type=float, default=1.0, help="seconds to keep turning (default 1)")
-    p.add_argument("--rate", type=float, default=25.0, help="keep-alive rate in Hz (default 25)")
+    p.add_argument("--rate", type=float, default=25.0,
+                   help=f"keep-alive rate in Hz, {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} (default 25)")
 
 
 def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:

@@ -9,6 +9,7 @@ from typing import Any
 
 from gimbal.client import GimbalClient, exit_on_signals, signal_exit_name
 from gimbal.errors import GimbalError, GimbalTimeoutError
+from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from pipelines.acquire import PICKS, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options
@@ -52,8 +53,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     control.add_argument("--hfov", type=float, metavar="DEG",
                          help="camera horizontal field of view (default: 24 mm lens on full frame, 73.7)")
     control.add_argument("--rate", type=float, default=25.0, metavar="HZ",
-                         help="keep-alive rate of the speed command (default: 25; one command lasts 0.5 s); "
-                         "a new setpoint goes out at once, but never more than twice this often")
+                         help=f"keep-alive rate of the speed command, {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} "
+                         "(default: 25; one command lasts 0.5 s); a new setpoint goes out at once, but "
+                         "never more than twice this often")
     control.add_argument("--max-speed", type=float, metavar="DEG_S",
                          help=f"speed limit in deg/s (default: {ControlConfig().max_speed_dps:g}, "
                          f"at most {PROTOCOL_MAX_SPEED_DPS:g})")
@@ -85,8 +87,9 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         roi = parse_roi(args.roi) if args.roi else None
     except ValueError as exc:
         raise CliError(str(exc)) from None
-    if not args.rate > 0:
-        raise CliError("--rate must be positive")
+    if not MIN_RATE_HZ <= args.rate <= MAX_RATE_HZ:
+        raise CliError(f"--rate takes {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz (one command lasts 0.5 s), "
+                       f"not {args.rate:g}")
     if args.max_speed is not None and not 0 < args.max_speed <= PROTOCOL_MAX_SPEED_DPS:
         raise CliError(f"--max-speed takes 0 < DEG_S <= {PROTOCOL_MAX_SPEED_DPS:g} (the protocol's limit)")
     if args.video_width < 0 or args.video_width == 1:

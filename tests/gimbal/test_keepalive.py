@@ -219,3 +219,9 @@ def test_a_stop_repeated_after_an_interrupted_one_waits_for_the_last_send(
     client.safety_stop()  # what the client's close() does next
     time.sleep(0.5)  # a send still under way would land by now
     assert speed_messages(peer)[-3:] == [(60, 0, 60, 0x88), ZERO, RELEASE]
+
+
+@pytest.mark.parametrize("rate", [3.9, 51.0, float("inf"), float("nan")])
+def test_rates_outside_4_to_50_hz_are_refused(client: GimbalClient, rate: float) -> None:
+    with pytest.raises(ValueError, match="4 to 50 Hz"):
+        SpeedStreamer(client, rate_hz=rate)

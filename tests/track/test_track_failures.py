@@ -42,6 +42,8 @@ def _one_line_error(capsys: pytest.CaptureFixture[str], *words: str) -> str:
     (["--roi", "10,10,0,5"], ["w and h"]),
     (["--tracker", "no-such-tracker"], ["no-such-tracker"]),
     (["--max-speed", "400"], ["--max-speed"]),
+    (["--rate", "2"], ["--rate", "4 to 50"]),  # once a traceback from the keep-alive
+    (["--rate", "inf"], ["--rate"]),
 ])
 def test_bad_options_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                          args: list[str], words: list[str]) -> None:
