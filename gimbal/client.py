@@ -15,14 +15,12 @@ from __future__ import annotations
 
 import atexit
 import logging
-import signal
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from types import FrameType, TracebackType
+from types import TracebackType
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import can
@@ -597,55 +595,3 @@ class GimbalClient:
         if recording is None:
             raise GimbalError("camera status reply carries no status")
         return recording
-
-
-#: What ends a process politely besides Ctrl-C: ``kill``, a closed terminal (SIGHUP), Ctrl-\ (SIGQUIT).
-TERMINATING_SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP", "SIGQUIT")
-                            if hasattr(signal, name))
-
-
-def signal_exit_name(code: object) -> str:
-    """The signal behind an ``exit_on_signals`` exit status (143 -> ``SIGTERM``)."""
-    try:
-        return signal.Signals(int(code) - 128).name  # type: ignore[call-overload]
-    except (TypeError, ValueError):
-        return "a signal"
-
-
-@contextmanager
-def exit_on_signals(signals: Iterable[int] = TERMINATING_SIGNALS) -> Iterator[None]:
-    """Turn the given signals into ``SystemExit(128 + signum)`` in the main thread, so ``with
-    GimbalClient(...)`` blocks unwind and send the safety stop (Ctrl-C already raises
-    ``KeyboardInterrupt``). Outside the main thread it changes nothing."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum: int, frame: FrameType | None) -> None:
-        raise SystemExit(128 + signum)
-
-    previous = {s: signal.signal(s, handler) for s in signals}
-    try:
-        yield
-    finally:
-        for s, old in previous.items():
-            signal.signal(s, old)
-
-
-@contextmanager
-def deferred_signals(signals: Iterable[int] = (signal.SIGINT, *TERMINATING_SIGNALS)) -> Iterator[None]:
-    """Hold the given signals until the block ends, then deliver them to the handlers in place
-    before it, so a unit of work (one frame and its outputs) is done whole or not at all. Outside
-    the main thread it changes nothing."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    pending: list[int] = []
-    previous = {s: signal.signal(s, lambda signum, frame: pending.append(signum)) for s in signals}
-    try:
-        yield
-    finally:
-        for s, old in previous.items():
-            signal.signal(s, old)
-        for signum in dict.fromkeys(pending):
-            signal.raise_signal(signum)

@@ -14,9 +14,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gimbal.client import GimbalClient, deferred_signals
+from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError
 from gimbal.messages import ParameterPush
+from gimbal.signals import deferred_signals
 from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
 from pipelines.control import AttitudeHistory, CameraModel, ControlConfig, make_controller
 from pipelines.outputs.annotated_video import BackgroundVideoWriter
@@ -264,7 +265,12 @@ class TrackSession:
 
     # -- the end -------------------------------------------------------------------------
     def finish(self, reason: str | None = None, error: str | None = None) -> dict[str, Any]:
-        """Stop the gimbal, stop recording, finalise every output; safe to call after any failure."""
+        """Stop the gimbal, stop recording, finalise every output; safe to call after any failure.
+        Ctrl-C and terminating signals during it are dropped: a stop is already under way."""
+        with deferred_signals(deliver=False):
+            return self._finish(reason, error)
+
+    def _finish(self, reason: str | None, error: str | None) -> dict[str, Any]:
         if reason:
             self.reason = reason
         self.error = error or self.error

@@ -7,6 +7,7 @@ import logging
 import os
 import sys
 
+from gimbal.signals import SignalExit, exit_on_signals
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError
 
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
@@ -37,21 +38,27 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
-    logging.basicConfig(level=level,
-                        format="%(levelname)s %(name)s: %(message)s")
+    prog = "gimbaltrack"
     try:
-        return int(args.func(args) or 0)
-    except CliError as exc:
-        if args.debug:
-            raise
-        print(f"gimbaltrack {args.command}: error: {exc}", file=sys.stderr)
-        return exc.exit_code
+        with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            prog = f"gimbaltrack {args.command}"
+            level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
+            logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+            try:
+                return int(args.func(args) or 0)
+            except CliError as exc:
+                if args.debug:
+                    raise
+                print(f"{prog}: error: {exc}", file=sys.stderr)
+                return exc.exit_code
     except KeyboardInterrupt:
-        print(f"gimbaltrack {args.command}: interrupted", file=sys.stderr)
+        print(f"{prog}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except SignalExit as exc:
+        print(f"{prog}: terminated ({exc.signal_name})", file=sys.stderr)
+        return int(exc.code)
     except BrokenPipeError:  # the reader went away (e.g. `| head`): not an error of ours
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0

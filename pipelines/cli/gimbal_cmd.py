@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, FIRST_SEQ,
-                           GimbalClient, exit_on_signals, lookup, position_message, speed_message)
+                           GimbalClient, lookup, position_message, speed_message)
 from gimbal.errors import GimbalError, GimbalTimeoutError, RangeError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.messages import Message, message_packet
@@ -502,7 +502,7 @@ def run(command: Command, args: argparse.Namespace) -> int:
             return 0
         if not args.timeout > 0:
             raise CliError("--timeout must be > 0")
-        with exit_on_signals(), open_host_bus(args) as bus, \
+        with open_host_bus(args) as bus, \
                 GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id, timeout=args.timeout) as client:
             result = command.run(client, args)
     except RangeError as exc:

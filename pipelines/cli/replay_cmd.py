@@ -16,7 +16,7 @@ from typing import Any, TextIO
 
 import can
 
-from gimbal.client import exit_on_signals, stop_messages
+from gimbal.client import stop_messages
 from gimbal.errors import PayloadError, RangeError
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
@@ -238,7 +238,7 @@ def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
     if not Path(args.log).exists():  # python-can would complain about the suffix first
         raise CliError(f"{args.log}: no such file")
     summary = ReplaySummary()
-    with _target(args) as (bus, sim), exit_on_signals():
+    with _target(args) as (bus, sim):
         started = time.monotonic()
         completed = False
         try:

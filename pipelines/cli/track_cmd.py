@@ -7,9 +7,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from gimbal.client import GimbalClient, exit_on_signals, signal_exit_name
+from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
+from gimbal.signals import SignalExit
 from pipelines.acquire import PICKS, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options
@@ -108,10 +109,9 @@ def _options(args: argparse.Namespace) -> TrackOptions:
 
 
 def run_track(args: argparse.Namespace) -> int:
-    options = _options(args)
-    # SIGTERM, SIGHUP and SIGQUIT unwind like Ctrl-C from here on: every ``with`` below stops the gimbal on the way out
-    with exit_on_signals():
-        return _open_and_run(options, args)
+    # main() turns SIGTERM, SIGHUP and SIGQUIT into SignalExit: every ``with`` below stops the
+    # gimbal on the way out, and _run finalises the outputs first
+    return _open_and_run(_options(args), args)
 
 
 def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
@@ -161,8 +161,8 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         _report(session.finish("interrupted (SIGINT)"), args)
         return EXIT_INTERRUPTED
-    except SystemExit as exc:
-        _report(session.finish(f"terminated ({signal_exit_name(exc.code)})"), args)
+    except SignalExit as exc:
+        _report(session.finish(f"terminated ({exc.signal_name})"), args)
         return int(exc.code or 1)
     except SourceError as exc:
         session.finish("source failed", str(exc))

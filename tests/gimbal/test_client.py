@@ -11,7 +11,7 @@ from typing import Any
 import can
 import pytest
 
-from gimbal.client import Angles, GimbalClient, deferred_signals, exit_on_signals
+from gimbal.client import Angles, GimbalClient
 from gimbal.errors import BusError, GimbalTimeoutError, RangeError, ReturnCodeError
 from gimbal.messages import Message
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
@@ -55,6 +55,7 @@ from gimbal.messages.tlv_params import (
     motors_off,
 )
 from gimbal.packet import encode_packet
+from gimbal.signals import deferred_signals, exit_on_signals
 from tests.gimbal.scripted_peer import (
     RELEASE,
     ZERO,
@@ -369,6 +370,16 @@ def test_signals_in_a_deferred_block_arrive_once_when_it_ends() -> None:
             signal.raise_signal(signal.SIGINT)
             done.append("finished before Ctrl-C lands")
     assert done[-1] == "finished before Ctrl-C lands"
+
+
+def test_signals_during_a_clean_up_are_dropped() -> None:
+    """The clean-up after a stop (deliver=False) runs to its end whatever else arrives."""
+    done = []
+    with exit_on_signals(), deferred_signals(deliver=False):
+        signal.raise_signal(signal.SIGINT)
+        signal.raise_signal(signal.SIGTERM)
+        done.append("outputs finalised")
+    assert done == ["outputs finalised"]
 
 
 def test_no_speed_command_on_exit_when_speed_was_never_used(client: GimbalClient,

@@ -119,12 +119,13 @@ def _wait_for(predicate, timeout: float, what: str) -> None:  # type: ignore[no-
     assert wait_until(predicate, timeout, step=0.05), f"timed out waiting for {what}"
 
 
-@pytest.mark.parametrize("signum, code, status", [
-    (signal.SIGINT, 130, "interrupted (SIGINT)"),
-    (signal.SIGTERM, 143, "terminated (SIGTERM)"),
-    (signal.SIGHUP, 129, "terminated (SIGHUP)"),  # the terminal closed
+@pytest.mark.parametrize("signums, code, status", [
+    ([signal.SIGINT], 130, "interrupted (SIGINT)"),
+    ([signal.SIGTERM], 143, "terminated (SIGTERM)"),
+    ([signal.SIGHUP], 129, "terminated (SIGHUP)"),  # the terminal closed
+    ([signal.SIGINT, signal.SIGINT], 130, "interrupted (SIGINT)"),  # an impatient second Ctrl-C
 ])
-def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signum: int, code: int,
+def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: list[int], code: int,
                                                       status: str) -> None:
     """track and a ``gimbaltrack sim`` in separate processes on udp_multicast (a private port)."""
     env = subprocess_env(free_udp_port())
@@ -138,7 +139,9 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signum: in
         telemetry = out / "telemetry.jsonl"
         _wait_for(lambda: telemetry.exists() and len(telemetry.read_text().splitlines()) > 40, 20,
                   "tracking")
-        track.send_signal(signum)
+        for signum in signums:
+            track.send_signal(signum)
+            time.sleep(0.002)
         stdout, stderr = track.communicate(timeout=15)
         assert track.returncode == code, stderr
         assert "Traceback" not in stderr
