@@ -72,3 +72,15 @@ def parse_roi(text: str) -> tuple[int, int, int, int]:
     if w <= 0 or h <= 0 or x < 0 or y < 0:
         raise ValueError(f"--roi {text!r}: x and y must be >= 0, w and h > 0")
     return x, y, w, h
+
+
+def roi_in_frame(roi: tuple[int, int, int, int], size: tuple[int, int]) -> tuple[int, int, int, int]:
+    """``roi`` cut to the frame of ``size`` (w, h); raises ValueError when less than half of it lies
+    inside (a typo or another clip's coordinates: tracking a background patch would drive the gimbal)."""
+    x, y, w, h = roi
+    width, height = size
+    x1, y1 = min(x + w, width), min(y + h, height)
+    if x1 <= x or y1 <= y or (x1 - x) * (y1 - y) < 0.5 * w * h:
+        raise ValueError(f"--roi {x},{y},{w},{h} lies {'outside' if x1 <= x or y1 <= y else 'mostly outside'} "
+                         f"the {width}x{height} frame")
+    return x, y, x1 - x, y1 - y

@@ -56,7 +56,11 @@ def open_can_bus(options: dict[str, Any]) -> can.BusABC:
 @contextmanager
 def simulated_gimbal(args: argparse.Namespace) -> Iterator[tuple[can.BusABC, SimulatedGimbal]]:
     """(host bus, simulated gimbal) for ``-i sim``: the simulator listens on --tx-id and answers
-    on --rx-id; both are stopped on exit."""
+    on --rx-id; both are stopped on exit. A channel or bitrate given with it is refused: whoever
+    gives one means a real bus and forgot -i."""
+    if args.channel is not None or args.bitrate is not None:
+        raise CliError("-c/--channel and -b/--bitrate need -i/--interface (a python-can interface); "
+                       "without -i the built-in simulated gimbal is used")
     host_bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id))
     try:
         yield host_bus, sim

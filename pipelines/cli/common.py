@@ -23,6 +23,22 @@ def parse_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
 
 
+def parse_can_id(text: str) -> int:
+    """A standard (11-bit) CAN id, decimal or 0x..."""
+    value = parse_int(text)
+    if not 0 <= value <= 0x7FF:
+        raise argparse.ArgumentTypeError(f"not a standard CAN id (0 to 0x7FF): {text!r}")
+    return value
+
+
+def parse_bitrate(text: str) -> int:
+    """A bitrate in bit/s, above zero."""
+    value = parse_int(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"a bitrate is above 0 bit/s, not {text!r}")
+    return value
+
+
 def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | None = None,
                     repeated: bool = False) -> None:
     """python-can's own options; unset values fall back to can.rc, CAN_* variables and ~/.canrc.
@@ -38,10 +54,12 @@ def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | No
         + (f" (default: {default_interface})" if default_interface else
            " (default: python-can's configuration)"),
     )
-    group.add_argument("-c", "--channel", help="channel, e.g. can0, /dev/ttyACM0, PCAN_USBBUS1, a multicast group")
-    group.add_argument("-b", "--bitrate", type=int, help="bitrate in bit/s (DJI RS gimbals use 1000000)")
-    group.add_argument("--tx-id", type=parse_int, default=0x223, help="CAN id the host sends on (default 0x223)")
-    group.add_argument("--rx-id", type=parse_int, default=0x222, help="CAN id the host listens on (default 0x222)")
+    group.add_argument("-c", "--channel", help="channel, e.g. can0, /dev/ttyACM0, PCAN_USBBUS1, a multicast "
+                       "group (with -i only)")
+    group.add_argument("-b", "--bitrate", type=parse_bitrate,
+                       help="bitrate in bit/s (DJI RS gimbals use 1000000; with -i only)")
+    group.add_argument("--tx-id", type=parse_can_id, default=0x223, help="CAN id the host sends on (default 0x223)")
+    group.add_argument("--rx-id", type=parse_can_id, default=0x222, help="CAN id the host listens on (default 0x222)")
     if repeated:
         suppress_defaults(group._group_actions)
 

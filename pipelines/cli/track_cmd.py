@@ -2,7 +2,9 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -11,7 +13,7 @@ from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit
-from pipelines.acquire import PICKS, parse_roi
+from pipelines.acquire import PICKS, parse_roi, roi_in_frame
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options
 from pipelines.control import ControlConfig, controller_names
@@ -95,6 +97,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError(f"--max-speed takes 0 < DEG_S <= {PROTOCOL_MAX_SPEED_DPS:g} (the protocol's limit)")
     if args.video_width < 0 or args.video_width == 1:
         raise CliError("--video-width takes 0 (full size) or at least 2 pixels")
+    if args.fps is not None and not 0 < args.fps < math.inf:
+        raise CliError(f"--fps takes a frame rate above 0, not {args.fps:g}")
     if args.max_frames is not None and args.max_frames < 1:
         raise CliError("--max-frames must be at least 1")
     detect = args.detect or (None if roi else DEFAULT_DETECTOR)
@@ -120,21 +124,40 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
     except SourceError as exc:
         raise CliError(str(exc)) from None
     with source:
-        try:
-            options.out_dir.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise CliError(f"cannot create output folder {options.out_dir}: {exc.strerror}") from None
-        can_log = CanLogWriter(options.out_dir / "can.log")
-        try:
-            with open_host_bus(args) as bus, LoggingBus(bus, can_log) as logged, \
-                    GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id) as client:
-                where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
-                         " ".join(str(v) for v in (args.interface or "python-can's configured bus",
-                                                   args.channel) if v))
-                session = _session(options, source, client, where, can_log)
-                return _run(session, args)
-        finally:
-            can_log.stop()
+        if options.roi is not None:
+            try:
+                options = dataclasses.replace(options, roi=roi_in_frame(options.roi, source.size))
+            except ValueError as exc:
+                raise CliError(str(exc)) from None
+        _make_out_dir(options.out_dir)
+        with open_host_bus(args) as bus:
+            can_log = _can_log(options.out_dir / "can.log")
+            try:
+                with LoggingBus(bus, can_log) as logged, \
+                        GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id) as client:
+                    where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
+                             " ".join(str(v) for v in (args.interface or "python-can's configured bus",
+                                                       args.channel) if v))
+                    session = _session(options, source, client, where, can_log)
+                    return _run(session, args)
+            finally:
+                can_log.stop()
+
+
+def _make_out_dir(out: Path) -> None:
+    if out.exists() and not out.is_dir():
+        raise CliError(f"--out {out} is a file, not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CliError(f"cannot create output folder {out}: {exc.strerror}") from None
+
+
+def _can_log(path: Path) -> CanLogWriter:
+    try:
+        return CanLogWriter(path)
+    except OSError as exc:
+        raise CliError(f"cannot write in output folder {path.parent}: {exc.strerror}") from None
 
 
 def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, where: str,

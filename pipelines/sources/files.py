@@ -170,7 +170,9 @@ class ImageFolderSource(FileSource):
         if not files:
             raise SourceError(f"no .jpg or .png images in folder {path}")
         self._files = files
-        super().__init__(str(path), self._imread(files[0]), fps, len(files), realtime, clock, sleep)
+        first = self._imread(files[0])
+        self._shape = first.shape
+        super().__init__(str(path), first, fps, len(files), realtime, clock, sleep)
 
     @staticmethod
     def _imread(path: Path) -> np.ndarray:
@@ -180,4 +182,10 @@ class ImageFolderSource(FileSource):
         return image
 
     def _load(self, index: int) -> np.ndarray | None:
-        return self._imread(self._files[index]) if index < len(self._files) else None
+        if index >= len(self._files):
+            return None
+        image = self._imread(self._files[index])
+        if image.shape != self._shape:  # the tracker, the camera model and the video assume one size
+            raise SourceError(f"image {self._files[index]} is {image.shape[1]}x{image.shape[0]}, the folder's "
+                              f"first is {self._shape[1]}x{self._shape[0]}: one sequence has one frame size")
+        return image

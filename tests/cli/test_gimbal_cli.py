@@ -191,3 +191,17 @@ def test_bus_and_output_options_work_before_or_after_the_command(capsys):
     assert main(["gimbal", "version", "-i", "sim", "--json"]) == 0
     after = json.loads(capsys.readouterr().out)
     assert before == after == {"device_id": 1, "version": "02.05.00.00"}
+
+
+def test_can_ids_and_bitrates_are_checked() -> None:
+    import argparse
+
+    from pipelines.cli.common import parse_bitrate, parse_can_id
+
+    assert parse_can_id("0x7FF") == 0x7FF and parse_can_id("546") == 0x222
+    assert parse_bitrate("1000000") == 1_000_000
+    for bad in ("0x800", "-1"):
+        with pytest.raises(argparse.ArgumentTypeError, match="standard CAN id"):
+            parse_can_id(bad)
+    with pytest.raises(argparse.ArgumentTypeError, match="above 0"):
+        parse_bitrate("-5")

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from pipelines.acquire import StartConfirmer, parse_roi, pick_candidate
+from pipelines.acquire import StartConfirmer, parse_roi, pick_candidate, roi_in_frame
 from tracker.detectors import Detection
 
 SIZE = (640, 360)
@@ -57,3 +57,12 @@ def test_parse_roi_refuses_bad_boxes(text):
 
 def test_parse_roi_reads_a_box():
     assert parse_roi("10, 20,30,40") == (10, 20, 30, 40)
+
+
+def test_roi_in_frame_cuts_a_box_over_the_edge_and_refuses_one_mostly_outside():
+    assert roi_in_frame((10, 20, 30, 40), (640, 360)) == (10, 20, 30, 40)
+    assert roi_in_frame((600, 300, 60, 60), (640, 360)) == (600, 300, 40, 60)  # 2/3 inside: cut
+    with pytest.raises(ValueError, match="mostly outside the 640x360 frame"):
+        roi_in_frame((600, 300, 100, 100), (640, 360))
+    with pytest.raises(ValueError, match="lies outside"):
+        roi_in_frame((700, 400, 64, 96), (640, 360))

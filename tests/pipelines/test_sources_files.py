@@ -133,6 +133,15 @@ def test_unreadable_image_in_folder(tmp_path: Path) -> None:
         open_source(str(tmp_path))
 
 
+def test_an_image_of_another_size_in_the_folder_is_a_source_error(tmp_path: Path, frame_image) -> None:
+    for i, size in enumerate([(96, 64), (96, 64), (80, 64)]):
+        cv2.imwrite(str(tmp_path / f"{i:04d}.png"), frame_image(i, size))
+    with open_source(str(tmp_path)) as source:
+        assert source.read() is not None and source.read() is not None
+        with pytest.raises(SourceError, match="0002.png is 80x64, the folder's first is 96x64"):
+            source.read()
+
+
 def test_decoding_ahead_keeps_order_and_stops_on_close(small_video: Path) -> None:
     source = open_source(str(small_video))
     first = [source.read() for _ in range(3)]

@@ -14,7 +14,7 @@ import gimbal.sim
 import pipelines.cli.bus
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
-from tests.support import cli_command, free_udp_port, subprocess_env, wait_until
+from tests.support import ROOT, cli_command, free_udp_port, subprocess_env, wait_until
 from tests.track.helpers import (
     DEMO,
     DEMO_ROI,
@@ -44,6 +44,10 @@ def _one_line_error(capsys: pytest.CaptureFixture[str], *words: str) -> str:
     (["--max-speed", "400"], ["--max-speed"]),
     (["--rate", "2"], ["--rate", "4 to 50"]),  # once a traceback from the keep-alive
     (["--rate", "inf"], ["--rate"]),
+    (["--roi", "700,400,64,96"], ["--roi", "outside the 640x360 frame"]),  # once tracked the background
+    (["--roi", "138,152,64,96", "-c", "can0"], ["-c/--channel", "need -i"]),  # once the simulator, silently
+    (["--roi", "138,152,64,96", "--fps", "-3"], ["--fps"]),  # once a traceback
+    (["--roi", "138,152,64,96", "--out", str(ROOT / "README.md")], ["is a file, not a folder"]),
 ])
 def test_bad_options_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                          args: list[str], words: list[str]) -> None:
