@@ -223,14 +223,17 @@ class GimbalClient:
         """Zero speed (still in control), then zero with control released (bit 7 clear).
 
         With a live receive thread each waits for its reply (no retries: a failure is logged);
-        once the bus is known lost they are only sent, best effort.
+        once the bus is known lost they are only sent, best effort. ``stats`` counts those that
+        went out (``stop_zero_sent``, ``stop_release_sent``).
         """
         for message in stop_messages():
+            name = "stop_zero_sent" if message.ctrl_byte & SPEED_TAKE_CONTROL else "stop_release_sent"
             try:
                 if self._rx_error is None and not self._closed:
                     self.request(message, retries=0)
                 else:
                     self.transport.send(self._encode(message)[1])
+                self.stats[name] += 1
             except (GimbalError, can.CanError, OSError) as exc:
                 log.warning("safety stop (%s): %s", "zero speed" if message.ctrl_byte & SPEED_TAKE_CONTROL
                             else "release control", exc)

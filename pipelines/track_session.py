@@ -77,6 +77,7 @@ class _Series:
     yaw_rate: list[float] = field(default_factory=list)
     pitch_rate: list[float] = field(default_factory=list)
     # the angular error hypot(yaw, pitch) so far, kept as it goes for the summary
+    error_count: int = 0  # frames whose command had a subject to measure the error against
     error_sum: float = 0.0
     error_max: float | None = None
 
@@ -219,9 +220,12 @@ class TrackSession:
         attitude = self.history.latest()
         record: dict[str, Any] = {"frame": frame.index, "t": stamp,
                                   "t_run": time.monotonic() - self._started, "state": state}
+        if not self.source.is_live:  # where the frame sits in the recording
+            record["t_video"] = frame.index / (self.source.fps or ASSUMED_FPS)
         if estimate is not None:
             record.update(estimate_fields(estimate))
-        record.update({"error_deg": [command.yaw_error_deg, command.pitch_error_deg],
+        known = not math.isnan(command.yaw_error_deg)  # NaN: no subject behind this frame's command
+        record.update({"error_deg": [command.yaw_error_deg, command.pitch_error_deg] if known else None,
                        "rate_dps": [command.yaw_dps, command.pitch_dps], "mode": command.mode,
                        "attitude_deg": None if attitude is None else
                        [attitude.yaw, attitude.pitch, attitude.roll],
@@ -237,10 +241,11 @@ class TrackSession:
         s.pitch_error.append(command.pitch_error_deg)
         s.yaw_rate.append(command.yaw_dps)
         s.pitch_rate.append(command.pitch_dps)
-        error = math.hypot(command.yaw_error_deg, command.pitch_error_deg)
-        s.error_sum += error
-        if s.error_max is None or error > s.error_max or math.isnan(error):
-            s.error_max = error  # a NaN stays, as in a max over the series
+        if known:
+            error = math.hypot(command.yaw_error_deg, command.pitch_error_deg)
+            s.error_count += 1
+            s.error_sum += error
+            s.error_max = error if s.error_max is None else max(s.error_max, error)
 
     # -- recording -----------------------------------------------------------------------
     def _start_recording(self) -> None:
@@ -313,10 +318,12 @@ class TrackSession:
             "frames": self.frames, "elapsed_s": elapsed, "fps": self.frames / elapsed if elapsed > 0 else None,
             "frames_dropped": self.source.dropped,
             "states": dict(self.states), "first_acquired_s": self.first_acquired_s,
-            "angular_error_deg": {"mean": s.error_sum / len(s.t) if s.t else None, "max": s.error_max},
+            "angular_error_deg": {"mean": s.error_sum / s.error_count if s.error_count else None,
+                                  "max": s.error_max, "frames": s.error_count},
             "latency_ms": {k: (v * 1000.0 if isinstance(v, float) else v)
                            for k, v in latency_percentiles(latencies).items()},
-            "speed_commands": dict(streamer.stats) if streamer is not None else {},
+            "speed_commands": {**(streamer.stats if streamer is not None else {}),
+                               **{k: v for k, v in self.client.stats.items() if k.startswith("stop_")}},
             "recording": self.recording,
             "outputs": {k: str(v) for k, v in self.paths.items()},
         }

@@ -59,7 +59,8 @@ class RateCommand:
 
     ``stamp`` is the capture time of the frame behind it (for the streamer's latency figures);
     ``mode`` is ``track``, ``hold`` (target missing, following the prediction), ``ramp``
-    (slowing to zero) or ``idle``; errors are world-frame degrees (target minus predicted pointing).
+    (slowing to zero) or ``idle``; errors are world-frame degrees (target minus predicted pointing),
+    NaN when no target stands behind the setpoint (``idle``, ``ramp``).
     """
 
     yaw_dps: float
@@ -67,8 +68,8 @@ class RateCommand:
     roll_dps: float = 0.0
     stamp: float | None = None
     mode: str = "idle"
-    yaw_error_deg: float = 0.0
-    pitch_error_deg: float = 0.0
+    yaw_error_deg: float = math.nan
+    pitch_error_deg: float = math.nan
     latency_s: float = 0.0
 
 
@@ -228,7 +229,7 @@ class RateController:
         return math.copysign(math.sqrt(2.0 * c.brake_accel_dps2 * e) / c.kp, error)
 
     def _emit(self, yaw: float, pitch: float, mode: str, dt: float, estimate: TargetEstimate | None,
-              now: float, errors: tuple[float, float] = (0.0, 0.0), limit_accel: bool = True) -> RateCommand:
+              now: float, errors: tuple[float, float] = (math.nan, math.nan), limit_accel: bool = True) -> RateCommand:
         c = self.config
         accel = c.max_accel_dps2 if limit_accel else math.inf
         yaw = limit_rate(self._last.yaw_dps, yaw, c.max_speed_dps, accel, dt)
@@ -281,7 +282,8 @@ class ProportionalController:
         yaw = self._pid_yaw(dx, dt)
         pitch = self._pid_pitch(-dy, dt)
         stamp = estimate.timestamp if estimate is not None else None
-        e_yaw, e_pitch = self.camera.pixel_to_angles(self.camera.cx + dx, self.camera.cy + dy)
+        e_yaw, e_pitch = (self.camera.pixel_to_angles(self.camera.cx + dx, self.camera.cy + dy)
+                          if mode == "track" else (math.nan, math.nan))
         self._last = RateCommand(yaw, pitch, 0.0, stamp, mode, e_yaw, e_pitch,
                                  0.0 if stamp is None else now - stamp)
         return self._last

@@ -34,6 +34,9 @@ def test_demo_run_succeeds_and_stops_the_gimbal(demo_run: dict[str, Any]) -> Non
     assert demo_run["code"] == 0
     assert demo_run["summary"]["status"] == "end of source"
     assert_stopped_at_end(demo_run["records"])
+    sends = demo_run["summary"]["speed_commands"]  # the final zero and release counted too
+    assert sends["stop_zero_sent"] == sends["stop_release_sent"] == 1
+    assert sends["sent"] + 2 == len(speed_commands(demo_run["records"]))
 
 
 def test_speed_commands_keep_the_configured_rate_within_range(demo_run: dict[str, Any]) -> None:
@@ -83,9 +86,12 @@ def test_outputs_are_complete_and_readable(demo_run: dict[str, Any]) -> None:
 
 
 def test_summary_angular_error_is_that_of_the_telemetry(demo_run: dict[str, Any]) -> None:
-    errors = [float(np.hypot(*r["error_deg"])) for r in read_telemetry(demo_run["out"] / "telemetry.jsonl")]
+    telemetry = read_telemetry(demo_run["out"] / "telemetry.jsonl")
+    errors = [float(np.hypot(*r["error_deg"])) for r in telemetry if r["error_deg"] is not None]
     assert demo_run["summary"]["angular_error_deg"] == pytest.approx(
-        {"mean": sum(errors) / len(errors), "max": max(errors)}, rel=1e-12)
+        {"mean": sum(errors) / len(errors), "max": max(errors), "frames": len(errors)}, rel=1e-12)
+    # no subject behind the command (idle, ramping down), no error
+    assert all((r["error_deg"] is None) == (r["mode"] in ("idle", "ramp")) for r in telemetry)
 
 
 # Image axes: x grows to the right, y downwards. Controller: yaw positive to the right, pitch
@@ -142,6 +148,7 @@ def test_rates_ramp_to_zero_when_the_subject_leaves(tmp_path: Path) -> None:
     deadline = lost_at["t_run"] + ControlConfig().stop_within_s + 0.02  # a frame's slack
     after = [r for r in telemetry if r["t_run"] >= deadline]
     assert len(after) > 10 and all(r["rate_dps"] == [0.0, 0.0] for r in after)
+    assert all(r["error_deg"] is None for r in after)  # no subject: no error, not a zero one
     assert all(r["mode"] in ("hold", "ramp", "idle") for r in telemetry if r["t_run"] > lost_at["t_run"])
     # the streamed commands end at rest too
     speeds = speed_commands(decoded(tmp_path / "out" / "can.log"))
