@@ -232,9 +232,13 @@ class TrackSession:
                        "attitude_t": None if attitude is None else attitude.timestamp,
                        "dropped": self.source.dropped})
         self.telemetry.write(record)
-        if self.video is not None:
-            self.video.write(frame.image, estimate, (command.yaw_dps, command.pitch_dps),
-                             [f"mode {command.mode}"])
+        if self.video is not None:  # labelled with the source's frame index and the recording's time
+            shown_t = record.get("t_video", record["t_run"])
+            shown = None if estimate is None else dataclasses.replace(estimate, frame_index=frame.index,
+                                                                      timestamp=shown_t)
+            lines = [f"mode {command.mode}"] if shown else [f"#{frame.index} t={shown_t:.3f}s acquiring",
+                                                            f"mode {command.mode}"]
+            self.video.write(frame.image, shown, (command.yaw_dps, command.pitch_dps), lines)
         s = self.series
         s.t.append(record["t_run"])
         s.yaw_error.append(command.yaw_error_deg)
@@ -258,6 +262,9 @@ class TrackSession:
             self.recording["error"] = str(exc)
 
     def _stop_recording(self) -> None:
+        if self.recording["requested"] and self.first_acquired_s is None:
+            self.recording["started"] = False
+            self.recording["error"] = "the subject was never acquired"
         if not self.recording.get("started"):
             return
         try:

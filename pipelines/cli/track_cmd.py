@@ -211,6 +211,9 @@ def _report(summary: dict[str, Any], args: argparse.Namespace) -> None:
              f"({summary['fps'] or 0:.1f} fps) from {summary['source']}",
              f"subject: {states or 'never seen'}; tracker {summary['tracker']}, "
              f"controller {summary['controller']}, bus {summary['bus']}"]
+    if summary["first_acquired_s"] is None:
+        lines.append("subject never acquired: no detection was confirmed (try --roi x,y,w,h, "
+                     "or another --detect)")
     if latency["count"]:
         lines.append(f"capture -> command latency: p50 {latency['p50']:.1f} ms, "
                      f"p95 {latency['p95']:.1f} ms, p99 {latency['p99']:.1f} ms")
@@ -221,8 +224,8 @@ def _report(summary: dict[str, Any], args: argparse.Namespace) -> None:
 
 
 def _recording_text(recording: dict[str, Any]) -> str:
-    if "started" not in recording:
-        return "not started (the subject was never acquired)"
+    if not recording.get("started"):
+        return f"not started ({recording.get('error', 'the subject was never acquired')})"
     if recording.get("error"):
         return f"failed: {recording['error']}"
     started = "started (confirmed)" if recording.get("start_confirmed") else "started (NOT confirmed)"

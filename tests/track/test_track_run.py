@@ -170,3 +170,14 @@ def test_annotated_video_is_shrunk_to_the_chosen_width(tmp_path: Path, width: st
 def test_demo_video_keeps_its_size_under_the_default_width(demo_run: dict[str, Any]) -> None:
     ok, frame = cv2.VideoCapture(str(demo_run["out"] / "annotated.avi")).read()
     assert ok and frame.shape[1::-1] == (640, 360)
+
+
+def test_a_subject_never_acquired_is_said_and_recording_never_started(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    clip = make_clip(tmp_path / "empty.avi", 20, lambda i: None)  # background only
+    assert run_track(clip, tmp_path / "out", "--detect", "motion", "--record", "--no-video") == 0
+    assert "subject never acquired" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["first_acquired_s"] is None and summary["states"] == {"acquiring": 20}
+    assert summary["recording"] == {"requested": True, "started": False, "error": "the subject was never acquired"}
+    assert not [r for r in host_commands(decoded(tmp_path / "out" / "can.log")) if r["name"] == "camera_action"]
