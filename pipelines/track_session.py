@@ -324,6 +324,7 @@ class TrackSession:
             "attitude_feedback": self.feedback,
             "frames": self.frames, "elapsed_s": elapsed, "fps": self.frames / elapsed if elapsed > 0 else None,
             "frames_dropped": self.source.dropped,
+            "frames_expected": None if self.source.is_live else self.source.frame_count,
             "states": dict(self.states), "first_acquired_s": self.first_acquired_s,
             "angular_error_deg": {"mean": s.error_sum / s.error_count if s.error_count else None,
                                   "max": s.error_max, "frames": s.error_count},

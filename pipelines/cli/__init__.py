@@ -37,8 +37,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def quiet_opencv(argv: list[str]) -> None:
+    """Keep OpenCV's and FFmpeg's own warnings (``[ WARN:0@1.7] ...``, ``moov atom not found``) off
+    the terminal, where they bury the one-line error that explains them, unless ``--debug`` is
+    given or the variables are set already. Effective only before cv2 is imported."""
+    if "--debug" not in argv:
+        os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
+        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "8")  # AV_LOG_FATAL
+
+
 def main(argv: list[str] | None = None) -> int:
     prog = "gimbaltrack"
+    quiet_opencv(sys.argv[1:] if argv is None else argv)
     try:
         with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
             parser = build_parser()

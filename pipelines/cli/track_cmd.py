@@ -201,7 +201,15 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
     return 0
 
 
+#: A file that ends before this share of the frames its header announces was probably cut short.
+EARLY_END_FRACTION = 0.95
+
+
 def _report(summary: dict[str, Any], args: argparse.Namespace) -> None:
+    expected = summary["frames_expected"]
+    if summary["status"] == "end of source" and expected and summary["frames"] < EARLY_END_FRACTION * expected:
+        print(f"gimbaltrack track: warning: the source ended after {summary['frames']} of the {expected} "
+              "frames its header announces (a truncated or damaged file?)", file=sys.stderr)
     if args.json:
         print(json.dumps(summary, indent=2))
         return

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import shutil
+import subprocess
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +20,7 @@ from tests.track.helpers import (DEMO, DEMO_ROI, SIZE, assert_stopped_at_end, de
                                  speed_commands)
 
 SUMMARY_KEYS = {"status", "error", "source", "live", "bus", "tracker", "controller", "frames", "elapsed_s",
-                "fps", "frames_dropped", "states", "first_acquired_s", "angular_error_deg", "latency_ms",
+                "fps", "frames_dropped", "frames_expected", "states", "first_acquired_s", "angular_error_deg", "latency_ms",
                 "speed_commands", "recording", "outputs"}
 
 
@@ -32,6 +34,7 @@ def demo_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def test_demo_run_succeeds_and_stops_the_gimbal(demo_run: dict[str, Any]) -> None:
     assert demo_run["code"] == 0
+    assert demo_run["summary"]["frames"] == demo_run["summary"]["frames_expected"] == 270
     assert demo_run["summary"]["status"] == "end of source"
     assert_stopped_at_end(demo_run["records"])
     sends = demo_run["summary"]["speed_commands"]  # the final zero and release counted too
@@ -181,3 +184,17 @@ def test_a_subject_never_acquired_is_said_and_recording_never_started(
     assert summary["first_acquired_s"] is None and summary["states"] == {"acquiring": 20}
     assert summary["recording"] == {"requested": True, "started": False, "error": "the subject was never acquired"}
     assert not [r for r in host_commands(decoded(tmp_path / "out" / "can.log")) if r["name"] == "camera_action"]
+
+
+@pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs ffmpeg to cut a clip short")
+def test_a_file_cut_short_ends_with_a_warning(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Its index in front (faststart), the frames cut off: it decodes to the cut, then stops."""
+    whole = tmp_path / "whole.mp4"
+    subprocess.run(["ffmpeg", "-loglevel", "error", "-i", str(DEMO), "-c", "copy", "-movflags", "faststart",
+                    str(whole)], check=True)
+    cut = tmp_path / "cut.mp4"
+    cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])
+    assert run_track(cut, tmp_path / "out", "--roi", DEMO_ROI, "--no-video") == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["frames_expected"] == 270 and 0 < summary["frames"] < 0.95 * 270
+    assert f"ended after {summary['frames']} of the 270 frames" in capsys.readouterr().err
