@@ -28,13 +28,19 @@ def build_parser() -> argparse.ArgumentParser:
         description="Keep a subject framed with a DJI RS gimbal: track it in video, "
         "turn its position into yaw/pitch rates, and drive the gimbal over CAN (DJI R SDK).",
     )
-    parser.add_argument("-v", "--verbose", action="store_true",
-                        help="log warnings too (retries, timeouts, best-effort stops)")
-    parser.add_argument("--debug", action="store_true", help="log debug output and show tracebacks")
+    _add_logging_options(parser, False)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in SUBCOMMAND_MODULES:
         importlib.import_module(name).register(subparsers)
+    for subparser in subparsers.choices.values():  # after the command too: gimbaltrack track ... --debug
+        _add_logging_options(subparser, argparse.SUPPRESS)
     return parser
+
+
+def _add_logging_options(parser: argparse.ArgumentParser, default: object) -> None:
+    parser.add_argument("-v", "--verbose", action="store_true", default=default,
+                        help="log warnings too (retries, timeouts, best-effort stops)")
+    parser.add_argument("--debug", action="store_true", default=default, help="log debug output and show tracebacks")
 
 
 def quiet_opencv(argv: list[str]) -> None:

@@ -35,7 +35,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "log, summary, plot) are written to --out as the run goes.",
         epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
         "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
-        "  gimbaltrack track udp://127.0.0.1:5000 --detect person --realtime",
+        "  gimbaltrack track udp://127.0.0.1:5000 --detect person --realtime\n\n"
+        "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png\n"
+        "exit status: 0 done; 1 the gimbal, bus, source or an output failed mid-run; 2 bad input;\n"
+        "  130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to stop in every case)",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("source", help="video file, image folder, camera index (e.g. 0) or stream URL "
                         "(udp://, rtsp://, http://)")
@@ -47,9 +50,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     subject.add_argument("--pick", choices=PICKS,
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
-                         help=f"tracking backend: {', '.join(available_trackers())} (default: default)")
+                         help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
+                         "is nanotrack when --model-dir holds its files, else dcf)")
     subject.add_argument("--model-dir", type=Path,
-                         help="folder with optional model files (NanoTrack, YuNet)")
+                         help="folder with optional model files: NanoTrack (then the default tracker) and "
+                         "YuNet (then the face detector)")
     control = parser.add_argument_group("control")
     control.add_argument("--controller", choices=controller_names(), default="pid",
                          help="pid: world-frame Kalman + PID + feed-forward (default); p: proportional baseline")
@@ -63,7 +68,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help=f"speed limit in deg/s (default: {ControlConfig().max_speed_dps:g}, "
                          f"at most {PROTOCOL_MAX_SPEED_DPS:g})")
     control.add_argument("--attitude-feedback", choices=FEEDBACK_MODES, default="auto",
-                         help="use the gimbal attitude (camera on the gimbal): auto = for live sources only")
+                         help="use the gimbal attitude (camera on the gimbal); default auto: for live "
+                         "sources only")
     control.add_argument("--invert-yaw", action="store_true",
                          help="this gimbal turns the other way for positive yaw (check on hardware)")
     control.add_argument("--invert-pitch", action="store_true",

@@ -205,3 +205,8 @@ def test_can_ids_and_bitrates_are_checked() -> None:
             parse_can_id(bad)
     with pytest.raises(argparse.ArgumentTypeError, match="above 0"):
         parse_bitrate("-5")
+
+
+def test_logging_options_also_after_the_command(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["decode", "--hex", "AA", "--verbose"]) == 0
+    assert main(["--verbose", "decode", "--hex", "AA"]) == 0
