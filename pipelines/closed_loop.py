@@ -40,6 +40,7 @@ class LoopSettings:
     latency_s: float = 0.0  # added between capture and tracking
     fps: float = 30.0
     control: ControlConfig = ControlConfig()
+    model_dir: Path | None = None  # the tracker's model files (e.g. NanoTrack's), as make_tracker takes them
 
 
 @dataclass(frozen=True)
@@ -99,7 +100,7 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
     vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
     controller = make_controller(settings.controller, camera=vc.camera, config=settings.control)
     oracle = OracleTracker(vc.camera.width, vc.camera.height)
-    subject = None if settings.tracker == ORACLE else make_tracker(settings.tracker)
+    subject = None if settings.tracker == ORACLE else make_tracker(settings.tracker, settings.model_dir)
 
     host_bus, sim = start_in_process(SimConfig(yaw_continuous=True))
     steps: list[LoopStep] = []

@@ -45,6 +45,9 @@ class NanoTrackParams:
 
 def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
     """The backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v2/``)."""
+    if model_dir is None:
+        raise FileNotFoundError("NanoTrack needs its model files: pass a model directory (--model-dir, or "
+                                "model_dir= in Python) holding nanotrack_backbone*.onnx and nanotrack_head*.onnx")
     backbone = find_model_file(model_dir, "nanotrack_v2", "nanotrack_backbone*.onnx", "NanoTrack")
     head = find_model_file(model_dir, "nanotrack_v2", "nanotrack_head*.onnx", "NanoTrack")
     return backbone, head

@@ -2,10 +2,13 @@
 from __future__ import annotations
 
 import argparse
+import binascii
 import json
 import os
 import re
+import struct
 import sys
+import zlib
 from collections.abc import Iterable, Iterator
 from contextlib import closing
 from typing import Any, TextIO
@@ -19,6 +22,9 @@ from pipelines.cli.common import CliError, parse_int
 _DIRECTION_ALIASES = {"host": HOST_TO_GIMBAL, "gimbal": GIMBAL_TO_HOST, HOST_TO_GIMBAL: HOST_TO_GIMBAL,
                       GIMBAL_TO_HOST: GIMBAL_TO_HOST}
 _SEPARATORS = re.compile(r"[\s:,]+|0[xX](?=[0-9a-fA-F])")
+# How Python words a field that does not parse as a number, as python-can's readers pass it on.
+_BAD_NUMBER = re.compile(r"(?:invalid literal for int\(\) with base (?P<base>\d+)|"
+                         r"could not convert string to float): (?P<value>.*)")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -95,7 +101,8 @@ def _next_frame(iterator: Iterator[can.Message], path: str, frames: int) -> can.
     try:
         return next(iterator, None)
     except Exception as exc:  # python-can's readers raise many types (ValueError, BLFParseError, ...)
-        raise CliError(f"{path}: unreadable after {frames} frames: {exc}") from None
+        where = "at its first frame" if frames == 0 else f"after frame {frames}"
+        raise CliError(f"{path}: unreadable {where}: {_reason(exc)}") from exc
 
 
 def _open_log(path: str) -> Iterable[can.Message]:
@@ -106,7 +113,24 @@ def _open_log(path: str) -> Iterable[can.Message]:
     try:
         return can.LogReader(path)
     except Exception as exc:  # unknown suffix (ValueError), bad header (BLFParseError, struct.error), ...
-        raise CliError(f"{path}: cannot read as a CAN log: {exc}") from None
+        raise CliError(f"{path}: cannot read as a CAN log: {_reason(exc)}") from exc
+
+
+def _reason(exc: Exception) -> str:
+    """What is wrong with a CAN log, in a user's words rather than Python's (python-can's own are kept)."""
+    text = str(exc)
+    if match := _BAD_NUMBER.fullmatch(text):
+        kind = "hexadecimal number" if match["base"] == "16" else "number"
+        return f"{match['value']} is not a {kind}"
+    if "values to unpack" in text:
+        return "a line has too few or too many fields for this format"
+    if isinstance(exc, binascii.Error):
+        return "its data is not valid base64"
+    if isinstance(exc, UnicodeDecodeError):
+        return "it is not a text file"
+    if isinstance(exc, (struct.error, zlib.error, EOFError)):
+        return "it is cut short or corrupt"
+    return text
 
 
 def _close(reader: Any) -> None:

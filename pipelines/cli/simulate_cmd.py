@@ -3,13 +3,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, run_closed_loop
-from pipelines.cli.common import CliError
+from pipelines.cli.common import CliError, make_out_dir
 from pipelines.control.controller import controller_names
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
+from pipelines.virtual_camera import VirtualCamera
+from tracker.datasets import load_sequence
+from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers, resolve_name
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -17,7 +21,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "simulate", help="run tracker + control + client against the simulated gimbal on a sequence",
         description="Play SEQ_DIR (frames or a video with ground truth) through a narrower virtual "
         "camera mounted on the simulated gimbal (python-can virtual bus, simulator in-process), in "
-        "real time, and report how well the subject stays centred.")
+        "real time, and report how well the subject stays centred.",
+        epilog="examples:\n  gimbaltrack simulate ../shared/data/sequences/vot15_ball1\n"
+        "  gimbaltrack simulate ../shared/data/sequences/vot15_ball1 --tracker oracle --latency 100 --out /tmp/sim\n"
+        "  gimbaltrack simulate samples/demo.mp4 --controller p --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("sequence", metavar="SEQ_DIR", type=Path, help="sequence folder or video with ground truth")
     parser.add_argument("--fov", type=float, metavar="DEG",
                         help="horizontal field of view of the view (default: crop-equivalent, the "
@@ -29,12 +37,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--controller", choices=controller_names(), default="pid",
                         help="pid (default: world-frame PID + feed-forward + latency compensation) "
                         "or p (speed proportional to pixel error, the public-driver baseline)")
-    parser.add_argument("--tracker", default="default",
-                        help=f"tracker name (default: the project's default tracker), or {ORACLE!r}: "
-                        "the ground-truth box is the detection, isolating the control loop")
+    parser.add_argument("--tracker", default="default", choices=[ORACLE, *available_trackers()], metavar="NAME",
+                        help=f"one of: {', '.join(available_trackers())} (default: default = "
+                        f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND}), "
+                        f"or {ORACLE}: the ground-truth box is the detection, isolating the control loop")
+    parser.add_argument("--model-dir", type=Path, metavar="DIR",
+                        help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
+                        "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: none)")
     parser.add_argument("--fps", type=float, default=30.0, help="playback frame rate (default 30)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
-    parser.add_argument("--out", type=Path, metavar="DIR", help="write plot.png and summary.json here")
+    parser.add_argument("--out", type=Path, metavar="DIR",
+                        help="write plot.png and summary.json here (default: none, nothing is written)")
     parser.set_defaults(func=run)
 
 
@@ -72,25 +85,47 @@ def write_plot(path: Path, result: LoopResult) -> None:
         ylabels=["fraction of diagonal", "deg/s"])
 
 
+def _view_fov(sequence: Path, size: tuple[int, int], fov: float | None) -> float:
+    """The view's horizontal field of view: ``fov``, or the crop-equivalent one for ``sequence``'s frames."""
+    if fov is not None:
+        return fov
+    first = next(load_sequence(sequence).frames(), None)
+    if first is None:
+        raise ValueError(f"{sequence}: no frames")
+    return VirtualCamera((first.shape[1], first.shape[0]), size).camera.hfov_deg
+
+
 def run(args: argparse.Namespace) -> int:
     if args.latency < 0 or args.fps <= 0:
         raise CliError("--latency must be >= 0 and --fps > 0")
-    settings = LoopSettings(controller=args.controller, tracker=args.tracker, hfov_deg=args.fov,
-                            out_size=args.size, latency_s=args.latency / 1000.0, fps=args.fps)
+    if args.fov is not None and not 0 < args.fov < 180:
+        raise CliError(f"--fov takes 0 < DEG < 180, not {args.fov:g}")
+    # The settings name what is used (the resolved tracker, the view's field of view), so the summary does too.
+    tracker = args.tracker if args.tracker == ORACLE else resolve_name(args.tracker, args.model_dir)
     try:
+        settings = LoopSettings(controller=args.controller, tracker=tracker,
+                                hfov_deg=_view_fov(args.sequence, args.size, args.fov), out_size=args.size,
+                                latency_s=args.latency / 1000.0, fps=args.fps, model_dir=args.model_dir)
+        if args.out:
+            make_out_dir(args.out)
         result = run_closed_loop(args.sequence, settings)
     except (FileNotFoundError, ValueError) as exc:
         raise CliError(str(exc)) from exc
+    except (KeyboardInterrupt, SystemExit):  # Ctrl-C, or SIGTERM/SIGHUP/SIGQUIT turned into SystemExit
+        if args.out:
+            print(f"gimbaltrack simulate: note: stopped before the end, nothing written to {args.out}",
+                  file=sys.stderr)
+        raise
     summary = summary_of(result)
     if args.out:
-        args.out.mkdir(parents=True, exist_ok=True)
         write_plot(args.out / "plot.png", result)
         write_summary(args.out / "summary.json", summary)
     if args.json:
         print(json.dumps(summary))
         return 0
     ttc = summary["time_to_first_centre"]
-    print(f"{result.summary['frames']} frames, controller {args.controller}, tracker {args.tracker}, "
+    print(f"{result.summary['frames']} frames, controller {settings.controller}, tracker {settings.tracker}, "
+          f"view {args.size[0]}x{args.size[1]} at {settings.hfov_deg:.1f} deg, "
           f"+{args.latency:g} ms latency (capture to bus, median {summary['median_capture_to_bus_ms']:.0f} ms)")
     print(f"centring error (fraction of diagonal): mean {summary['mean_center_error']:.4f}, "
           f"RMS {summary['rms_center_error']:.4f}")

@@ -15,7 +15,7 @@ from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit
 from pipelines.acquire import PICKS, parse_roi, roi_in_frame
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
-from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options
+from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, make_out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter, LoggingBus
@@ -135,7 +135,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                 options = dataclasses.replace(options, roi=roi_in_frame(options.roi, source.size))
             except ValueError as exc:
                 raise CliError(str(exc)) from None
-        _make_out_dir(options.out_dir)
+        make_out_dir(options.out_dir)
         with open_host_bus(args) as bus:
             can_log = _can_log(options.out_dir / "can.log")
             try:
@@ -148,15 +148,6 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                     return _run(session, args)
             finally:
                 can_log.stop()
-
-
-def _make_out_dir(out: Path) -> None:
-    if out.exists() and not out.is_dir():
-        raise CliError(f"--out {out} is a file, not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise CliError(f"cannot create output folder {out}: {exc.strerror}") from None
 
 
 def _can_log(path: Path) -> CanLogWriter:

@@ -154,7 +154,11 @@ def open_stream(url: str, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
     """A network stream read by OpenCV's FFmpeg backend (udp://, rtsp://, http(s)://, ...)."""
     params = [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(open_timeout * 1000),
               cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(stall_timeout * 1000)]
+    started = time.monotonic()
     capture = cv2.VideoCapture(url, cv2.CAP_FFMPEG, params)
     if not capture.isOpened():
-        raise SourceError(f"cannot open stream {url} within {open_timeout:g} s")
+        if time.monotonic() - started >= open_timeout:
+            raise SourceError(f"cannot open stream {url}: nothing received within {open_timeout:g} s")
+        raise SourceError(f"cannot open stream {url} (connection refused, not found, or not a stream "
+                          "FFmpeg can read)")
     return LiveSource(capture, url, nominal_fps(capture), stall_timeout, open_timeout)

@@ -77,6 +77,21 @@ def test_unknown_format_and_corrupt_log(tmp_path: Path, capsys: pytest.CaptureFi
         assert code == 2 and len(err.strip().splitlines()) == 1, err
 
 
+@pytest.mark.parametrize("name, text, message", [
+    ("hex.log", "(1.0) can0 223#0011\n(2.0) can0 223#ZZ\n", "unreadable after frame 1: 'ZZ' is not a hexadecimal number"),
+    ("fields.log", "garbage\n", "unreadable at its first frame: a line has too few or too many fields for this format"),
+    ("time.log", "(x) can0 223#00\n", "unreadable at its first frame: 'x' is not a number"),
+    ("base64.csv", "timestamp,arbitration_id,extended,remote,error,dlc,data\n1.0,0x223,0,0,0,1,ZZ\n",
+     "unreadable at its first frame: its data is not valid base64"),
+])
+def test_a_malformed_log_line_is_worded_for_a_user(name: str, text: str, message: str, tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / name
+    path.write_text(text)
+    code, _, err = run([str(path)], capsys)
+    assert code == 2 and err == f"gimbaltrack decode: error: {path}: {message}\n"
+
+
 def test_direction_refused_for_logs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "empty.log"
     path.write_text("")

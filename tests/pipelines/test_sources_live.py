@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import itertools
+import socket
 import subprocess
 import threading
 from collections.abc import Callable
@@ -115,6 +116,26 @@ def test_live_source_that_never_delivers_does_not_open() -> None:
 def test_camera_that_does_not_open() -> None:
     with pytest.raises(SourceError, match="camera 97 does not open"):
         open_source("97")
+
+
+def test_refused_stream_is_not_called_a_timeout() -> None:
+    with socket.socket() as closed:  # a port nothing listens on once this is closed
+        closed.bind(("127.0.0.1", 0))
+        port = closed.getsockname()[1]
+    for url in (f"rtsp://127.0.0.1:{port}/live", f"http://127.0.0.1:{port}/live.mjpg"):
+        with pytest.raises(SourceError) as error:
+            open_source(url, open_timeout=WAIT)
+        assert str(error.value) == (f"cannot open stream {url} (connection refused, not found, or not a "
+                                    "stream FFmpeg can read)")
+
+
+def test_silent_stream_is_a_timeout() -> None:
+    with socket.socket() as server:  # accepts connections and never says a word
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        url = f"rtsp://127.0.0.1:{server.getsockname()[1]}/live"
+        with pytest.raises(SourceError, match=f"^cannot open stream {url}: nothing received within 0.5 s$"):
+            open_source(url, open_timeout=0.5)
 
 
 @pytest.fixture

@@ -1,0 +1,116 @@
+"""``gimbaltrack simulate``: what the summary reports, bad input caught before the run, SIGTERM."""
+from __future__ import annotations
+
+import json
+import math
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import cv2
+import pytest
+
+import pipelines.cli
+from pipelines.cli import main
+from pipelines.control.camera import DEFAULT_HFOV_DEG
+from tests.support import ROOT, cli_command, subprocess_env, wait_until
+from tracker.synthetic import render_sequence
+
+FRAMES = 12
+
+
+@pytest.fixture(autouse=True)
+def only_simulate(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The real dispatcher, with only this subcommand (others' modules are not under test here)."""
+    monkeypatch.setattr(pipelines.cli, "SUBCOMMAND_MODULES", ["pipelines.cli.simulate_cmd"])
+
+
+@pytest.fixture(scope="module")
+def sequence(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("simulate")
+    seq = render_sequence(frames=FRAMES, frame_size=(640, 360), target=40, speed=6.0)
+    for i, (image, box) in enumerate(zip(seq.frames, seq.boxes), start=1):
+        cv2.imwrite(str(folder / f"{i}.png"), image)
+    (folder / "groundtruth_rect.txt").write_text("".join(",".join(f"{v:.2f}" for v in b) + "\n" for b in seq.boxes))
+    return folder
+
+
+def simulate(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(["simulate", *argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_summary_reports_the_tracker_and_field_of_view_used(sequence: Path, tmp_path: Path,
+                                                            capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    code, stdout, _ = simulate([str(sequence), "--size", "320x180", "--fps", "60", "--json", "--out", str(out)],
+                               capsys)
+    assert code == 0
+    summary = json.loads(stdout)
+    # crop-equivalent: the 640 px source's focal length (24 mm full frame) seen by a 320 px view
+    source_focal = 320 / math.tan(math.radians(DEFAULT_HFOV_DEG) / 2)
+    assert summary["tracker"] == "dcf"
+    assert summary["fov_deg"] == pytest.approx(math.degrees(2 * math.atan(160 / source_focal)))
+    assert json.loads((out / "summary.json").read_text()) == summary
+    code, stdout, _ = simulate([str(sequence), "--fps", "60", "--fov", "50", "--tracker", "oracle"], capsys)
+    assert code == 0 and "tracker oracle, view 640x360 at 50.0 deg" in stdout
+
+
+def test_model_dir_reaches_the_tracker(sequence: Path, shared_data: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    code, stdout, _ = simulate([str(sequence), "--fps", "60", "--json", "--model-dir", str(shared_data / "models")],
+                               capsys)
+    assert code == 0 and json.loads(stdout)["tracker"] == "nanotrack"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--out", "{file}"], "--out {file} is a file, not a folder"),
+    (["--fov", "0"], "--fov takes 0 < DEG < 180, not 0"),
+    (["--tracker", "nanotrack", "--model-dir", "{empty}"], "NanoTrack: no nanotrack_backbone*.onnx in {empty}"),
+    (["--fov", "180"], "--fov takes 0 < DEG < 180, not 180"),
+])
+def test_bad_options_fail_at_once_in_one_line(argv: list[str], message: str, sequence: Path, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    file, empty = tmp_path / "results", tmp_path / "models"
+    file.write_text("")
+    empty.mkdir()
+    started = time.monotonic()
+    # --fps 1: the run itself would take 12 s
+    code, stdout, err = simulate([str(sequence), "--fps", "1", *(a.format(file=file, empty=empty) for a in argv)],
+                                 capsys)
+    assert time.monotonic() - started < 6
+    assert code == 2 and stdout == ""
+    assert err.startswith(f"gimbaltrack simulate: error: {message.format(file=file, empty=empty)}")
+    assert err.count("\n") == 1
+
+
+def test_help_lists_trackers_defaults_and_examples(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "oracle" in text and "dcf" in text and "csrt" in text
+    assert "(default: default = nanotrack when --model-dir holds its files, else dcf)" in text
+    assert "(default: none, nothing is written)" in text
+    assert "examples: gimbaltrack simulate" in text
+
+
+def test_sigterm_exits_143_and_says_nothing_was_written(sequence: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    process = subprocess.Popen(cli_command("simulate", str(sequence), "--fps", "2", "--out", str(out)),
+                               cwd=ROOT, env=subprocess_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True)
+    try:
+        assert wait_until(out.is_dir, 30), "the run never started"  # --out is made just before it
+        time.sleep(1.0)
+        process.send_signal(signal.SIGTERM)
+        stdout, stderr = process.communicate(timeout=15)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == 143 and stdout == ""
+    assert stderr == (f"gimbaltrack simulate: note: stopped before the end, nothing written to {out}\n"
+                      "gimbaltrack simulate: terminated (SIGTERM)\n")
+    assert list(out.iterdir()) == []
