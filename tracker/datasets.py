@@ -106,13 +106,20 @@ def list_images(folder: Path) -> list[Path]:
                   key=_natural_key)
 
 
+def frame_folder(folder: Path) -> Path:
+    """Where a sequence folder keeps its frames: its ``img/``, ``imgs/`` or ``color/`` (OTB, VOT)
+    when one holds images, else the folder itself."""
+    for candidate in (folder / d for d in FRAME_DIRS):
+        if candidate.is_dir() and list_images(candidate):
+            return candidate
+    return folder
+
+
 def _find_frames(folder: Path) -> tuple[Path, ...]:
-    for candidate in [folder / d for d in FRAME_DIRS] + [folder]:
-        if candidate.is_dir():
-            images = list_images(candidate)
-            if images:
-                return tuple(images)
-    raise ValueError(f"no image frames in {folder} (looked in {', '.join(FRAME_DIRS)} and the folder itself)")
+    images = list_images(frame_folder(folder))
+    if not images:
+        raise ValueError(f"no image frames in {folder} (looked in {', '.join(FRAME_DIRS)} and the folder itself)")
+    return tuple(images)
 
 
 def _find_groundtruth(folder: Path, *extra_names: str) -> Path | None:

@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 
 from pipelines.sources.base import Frame, FrameSource, SourceError, nominal_fps
-from tracker.datasets import ASSUMED_FPS, list_images
+from tracker.datasets import ASSUMED_FPS, FRAME_DIRS, frame_folder, list_images
 
 #: The image files an image folder source reads (a subset of what tracker.datasets lists).
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
@@ -161,14 +161,15 @@ class VideoFileSource(FileSource):
 
 
 class ImageFolderSource(FileSource):
-    """A folder of .jpg/.png images in natural name order (``img2`` before ``img10``)."""
+    """A folder of .jpg/.png images in natural name order (``img2`` before ``img10``); a benchmark
+    sequence's folder is read from its ``img/``, ``imgs/`` or ``color/``."""
 
     def __init__(self, path: Path, realtime: bool = False, fps: float | None = None,
                  clock: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep) -> None:
-        files = [p for p in list_images(path) if p.suffix.lower() in IMAGE_SUFFIXES]
+        files = [p for p in list_images(frame_folder(path)) if p.suffix.lower() in IMAGE_SUFFIXES]
         if not files:
-            raise SourceError(f"no .jpg or .png images in folder {path}")
+            raise SourceError(f"no .jpg or .png images in folder {path} (nor in its {', '.join(FRAME_DIRS)})")
         self._files = files
         first = self._imread(files[0])
         self._shape = first.shape

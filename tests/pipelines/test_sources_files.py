@@ -151,3 +151,12 @@ def test_decoding_ahead_keeps_order_and_stops_on_close(small_video: Path) -> Non
     source.close()
     assert not decoder.is_alive()
     assert source.read() is None
+
+
+def test_a_benchmark_sequence_folder_is_read_from_its_frames_subfolder(tmp_path: Path, frame_image) -> None:
+    (tmp_path / "img").mkdir()
+    for i in range(3):
+        cv2.imwrite(str(tmp_path / "img" / f"{i + 1:04d}.jpg"), frame_image(i))
+    (tmp_path / "groundtruth_rect.txt").write_text("1,2,3,4\n")
+    with open_source(str(tmp_path)) as source:
+        assert source.frame_count == 3 and len(list(source)) == 3
