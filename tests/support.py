@@ -5,10 +5,13 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import socket
+import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterable
+from typing import Any
 from pathlib import Path
 
 import cv2
@@ -27,6 +30,22 @@ def wait_until(predicate: Callable[[], object], timeout: float, step: float = 0.
             return True
         time.sleep(step)
     return bool(predicate())
+
+
+def signalled(command: list[str], ready: Callable[[subprocess.Popen[str]], object],
+              signum: int = signal.SIGTERM, timeout: float = 30.0, **popen: Any) -> tuple[int, str, str]:
+    """Run ``command``, send it ``signum`` once ``ready(process)`` says it is under way, and return
+    (exit status, stdout, stderr); a process still alive after ``timeout`` s is killed."""
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
+    try:
+        assert ready(process), "the run never got under way"
+        process.send_signal(signum)
+        stdout, stderr = process.communicate(timeout=timeout)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    return process.returncode, stdout, stderr
 
 
 def cli_command(*args: str) -> list[str]:

@@ -3,37 +3,21 @@ from __future__ import annotations
 
 import json
 import math
-import signal
 import subprocess
 import time
 from pathlib import Path
 
-import cv2
 import pytest
 
 import pipelines.cli
 from pipelines.cli import main
 from pipelines.control.camera import DEFAULT_HFOV_DEG
-from tests.support import ROOT, cli_command, subprocess_env, wait_until
-from tracker.synthetic import render_sequence
-
-FRAMES = 12
-
+from tests.support import ROOT, cli_command, signalled, subprocess_env, wait_until
 
 @pytest.fixture(autouse=True)
 def only_simulate(monkeypatch: pytest.MonkeyPatch) -> None:
     """The real dispatcher, with only this subcommand (others' modules are not under test here)."""
     monkeypatch.setattr(pipelines.cli, "SUBCOMMAND_MODULES", ["pipelines.cli.simulate_cmd"])
-
-
-@pytest.fixture(scope="module")
-def sequence(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("simulate")
-    seq = render_sequence(frames=FRAMES, frame_size=(640, 360), target=40, speed=6.0)
-    for i, (image, box) in enumerate(zip(seq.frames, seq.boxes), start=1):
-        cv2.imwrite(str(folder / f"{i}.png"), image)
-    (folder / "groundtruth_rect.txt").write_text("".join(",".join(f"{v:.2f}" for v in b) + "\n" for b in seq.boxes))
-    return folder
 
 
 def simulate(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
@@ -98,19 +82,15 @@ def test_help_lists_trackers_defaults_and_examples(capsys: pytest.CaptureFixture
 
 def test_sigterm_exits_143_and_says_nothing_was_written(sequence: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
-    process = subprocess.Popen(cli_command("simulate", str(sequence), "--fps", "2", "--out", str(out)),
-                               cwd=ROOT, env=subprocess_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)
-    try:
-        assert wait_until(out.is_dir, 30), "the run never started"  # --out is made just before it
+
+    def running(process: subprocess.Popen[str]) -> bool:
+        started = wait_until(out.is_dir, 30)  # --out is made just before the run
         time.sleep(1.0)
-        process.send_signal(signal.SIGTERM)
-        stdout, stderr = process.communicate(timeout=15)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait()
-    assert process.returncode == 143 and stdout == ""
+        return started
+
+    code, stdout, stderr = signalled(cli_command("simulate", str(sequence), "--fps", "2", "--out", str(out)),
+                                     running, cwd=ROOT, env=subprocess_env())
+    assert code == 143 and stdout == ""
     assert stderr == (f"gimbaltrack simulate: note: stopped before the end, nothing written to {out}\n"
                       "gimbaltrack simulate: terminated (SIGTERM)\n")
     assert list(out.iterdir()) == []

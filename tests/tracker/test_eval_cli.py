@@ -1,14 +1,13 @@
 """``gimbaltrack eval``: text and JSON output, and one-line errors."""
 import json
 import re
-import signal
 import subprocess
 from pathlib import Path
 
 import cv2
 import pytest
 
-from tests.support import cli_command, write_clip
+from tests.support import cli_command, signalled, write_clip
 from tracker.synthetic import render_sequence
 
 
@@ -113,15 +112,7 @@ def test_sigterm_exits_143_with_a_note(tmp_path):
         (tmp_path / "img" / f"{i:05d}.png").symlink_to(tmp_path / f"{i % 2 + 1}.png")
     box = ",".join(f"{v:.1f}" for v in frames.boxes[0])
     (tmp_path / "groundtruth_rect.txt").write_text(f"{box}\n" * count)
-    process = subprocess.Popen(cli_command("eval", str(tmp_path), "--tracker", "csrt"), stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
-    try:
-        assert process.stderr.readline().startswith("[")  # a progress line: the run is under way
-        process.send_signal(signal.SIGTERM)
-        stdout, stderr = process.communicate(timeout=30)
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait()
-    assert process.returncode == 143 and stdout == ""
+    code, stdout, stderr = signalled(cli_command("eval", str(tmp_path), "--tracker", "csrt"),
+                                     lambda process: process.stderr.readline().startswith("["))  # progress
+    assert code == 143 and stdout == ""
     assert stderr.splitlines()[-1] == "gimbaltrack eval: terminated (SIGTERM)" and "Traceback" not in stderr
