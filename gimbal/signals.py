@@ -61,3 +61,20 @@ def deferred_signals(signals: Iterable[int] = (signal.SIGINT, *TERMINATING_SIGNA
             signal.signal(s, old)
         for signum in dict.fromkeys(pending) if deliver else ():
             signal.raise_signal(signum)
+
+
+@contextmanager
+def blocked_signals(signals: Iterable[int] = (signal.SIGINT, *TERMINATING_SIGNALS)) -> Iterator[None]:
+    """Keep the given signals pending at the OS level until the block ends, then let them arrive.
+    For loading numpy, SciPy and OpenCV: some of their modules swap signal handlers while they
+    load, and a Ctrl-C landing then could be lost or turned into an import error. Threads started
+    inside the block keep them blocked, so the main thread is the one that receives them. Where
+    the OS cannot block signals, it changes nothing."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, set(signals))
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)

@@ -69,8 +69,8 @@ def parse_roi(text: str) -> tuple[int, int, int, int]:
         x, y, w, h = (int(float(p)) for p in parts)
     except ValueError:
         raise ValueError(f"--roi takes x,y,w,h in pixels, not {text!r}") from None
-    if w <= 0 or h <= 0 or x < 0 or y < 0:
-        raise ValueError(f"--roi {text!r}: x and y must be >= 0, w and h > 0")
+    if w <= 0 or h <= 0:
+        raise ValueError(f"--roi {text!r}: w and h must be > 0")
     return x, y, w, h
 
 
@@ -79,8 +79,8 @@ def roi_in_frame(roi: tuple[int, int, int, int], size: tuple[int, int]) -> tuple
     inside (a typo or another clip's coordinates: tracking a background patch would drive the gimbal)."""
     x, y, w, h = roi
     width, height = size
-    x1, y1 = min(x + w, width), min(y + h, height)
-    if x1 <= x or y1 <= y or (x1 - x) * (y1 - y) < 0.5 * w * h:
-        raise ValueError(f"--roi {x},{y},{w},{h} lies {'outside' if x1 <= x or y1 <= y else 'mostly outside'} "
+    x0, y0, x1, y1 = max(x, 0), max(y, 0), min(x + w, width), min(y + h, height)
+    if x1 <= x0 or y1 <= y0 or (x1 - x0) * (y1 - y0) < 0.5 * w * h:
+        raise ValueError(f"--roi {x},{y},{w},{h} lies {'outside' if x1 <= x0 or y1 <= y0 else 'mostly outside'} "
                          f"the {width}x{height} frame")
-    return x, y, x1 - x, y1 - y
+    return x0, y0, x1 - x0, y1 - y0

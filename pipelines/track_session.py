@@ -20,7 +20,7 @@ from gimbal.messages import ParameterPush
 from gimbal.signals import deferred_signals
 from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
 from pipelines.control import AttitudeHistory, CameraModel, ControlConfig, make_controller
-from pipelines.outputs.annotated_video import BackgroundVideoWriter
+from pipelines.outputs.annotated_video import BackgroundVideoWriter, rates_text
 from pipelines.outputs.can_log import CanLogWriter
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.plot import write_timeseries_png
@@ -236,9 +236,12 @@ class TrackSession:
             shown_t = record.get("t_video", record["t_run"])
             shown = None if estimate is None else dataclasses.replace(estimate, frame_index=frame.index,
                                                                       timestamp=shown_t)
-            lines = [f"mode {command.mode}"] if shown else [f"#{frame.index} t={shown_t:.3f}s acquiring",
-                                                            f"mode {command.mode}"]
-            self.video.write(frame.image, shown, (command.yaw_dps, command.pitch_dps), lines)
+            rates = (command.yaw_dps, command.pitch_dps)
+            if shown is not None:
+                self.video.write(frame.image, shown, rates, [f"mode {command.mode}"])
+            else:  # the same three lines, the frame's first
+                self.video.write(frame.image, None, None, [f"#{frame.index} t={shown_t:.3f}s acquiring",
+                                                           rates_text(rates), f"mode {command.mode}"])
         s = self.series
         s.t.append(record["t_run"])
         s.yaw_error.append(command.yaw_error_deg)

@@ -7,7 +7,7 @@ import logging
 import os
 import sys
 
-from gimbal.signals import SignalExit, exit_on_signals
+from gimbal.signals import SignalExit, blocked_signals, exit_on_signals
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError
 
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
@@ -32,8 +32,12 @@ def build_parser() -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in SUBCOMMAND_MODULES:
         importlib.import_module(name).register(subparsers)
-    for subparser in subparsers.choices.values():  # after the command too: gimbaltrack track ... --debug
+    pending = list(subparsers.choices.values())
+    while pending:  # after the command too, at any depth: gimbaltrack gimbal angles --debug
+        subparser = pending.pop()
         _add_logging_options(subparser, argparse.SUPPRESS)
+        pending += [p for action in subparser._actions if isinstance(action, argparse._SubParsersAction)
+                    for p in action.choices.values()]
     return parser
 
 
@@ -57,7 +61,8 @@ def main(argv: list[str] | None = None) -> int:
     quiet_opencv(sys.argv[1:] if argv is None else argv)
     try:
         with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
-            parser = build_parser()
+            with blocked_signals():  # nor lost, or an import error, while numpy, SciPy and cv2 load
+                parser = build_parser()
             args = parser.parse_args(argv)
             prog = f"gimbaltrack {args.command}"
             level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR

@@ -59,8 +59,8 @@ def simulated_gimbal(args: argparse.Namespace) -> Iterator[tuple[can.BusABC, Sim
     on --rx-id; both are stopped on exit. A channel or bitrate given with it is refused: whoever
     gives one means a real bus and forgot -i."""
     if args.channel is not None or args.bitrate is not None:
-        raise CliError("-c/--channel and -b/--bitrate need -i/--interface (a python-can interface); "
-                       "without -i the built-in simulated gimbal is used")
+        raise CliError("the built-in simulated gimbal (-i sim, and track's default) takes no -c/--channel or "
+                       "-b/--bitrate: give -i with a python-can interface for a real bus")
     host_bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id))
     try:
         yield host_bus, sim

@@ -26,6 +26,21 @@ def make_out_dir(out: Path) -> None:
         raise CliError(f"cannot create output folder {out}: {exc.strerror}") from None
 
 
+def existing_dir(text: str) -> Path:
+    """An existing folder (``--model-dir``): a typo must not quietly mean "no models"."""
+    path = Path(text)
+    if not path.is_dir():
+        raise argparse.ArgumentTypeError(f"no such folder: {text!r}")
+    return path
+
+
+def out_dir(text: str) -> Path:
+    """An ``--out`` folder; an empty one is refused (it would mean the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path (use . for the current folder)")
+    return Path(text)
+
+
 def parse_int(text: str) -> int:
     """An integer in decimal or with a 0x/0o/0b prefix (for ids, SEQ and raw bytes)."""
     try:

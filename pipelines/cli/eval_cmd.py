@@ -4,11 +4,10 @@ from __future__ import annotations
 import argparse
 import json
 from collections.abc import Callable
-from pathlib import Path
 
 import cv2
 
-from pipelines.cli.common import CliError
+from pipelines.cli.common import CliError, existing_dir
 from pipelines.progress import ProgressReporter
 from tracker.datasets import GROUNDTRUTH_NAMES, Sequence, load_sequence
 from tracker.evaluation import SequenceResult, run_sequence, summarize
@@ -29,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--tracker", default="default", metavar="NAME",
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
                         f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND})")
-    parser.add_argument("--model-dir", type=Path, metavar="DIR",
+    parser.add_argument("--model-dir", type=existing_dir, metavar="DIR",
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
                         "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: none)")
     parser.add_argument("--json", action="store_true", help="one JSON object per sequence, then a summary object")

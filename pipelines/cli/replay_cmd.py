@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from collections import Counter
@@ -233,8 +234,10 @@ def _target(args: argparse.Namespace) -> Iterator[tuple[can.BusABC | None, Any]]
 
 def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
     out = out or sys.stdout
-    if not args.speed > 0:
-        raise CliError(f"--speed must be positive, not {args.speed}")
+    if not 0 < args.speed < math.inf:
+        raise CliError(f"--speed takes a finite factor above 0, not {args.speed:g}")
+    if args.interface is None and (args.channel is not None or args.bitrate is not None):
+        raise CliError("-c/--channel and -b/--bitrate need -i/--interface: replay sends onto a bus only with -i")
     if not Path(args.log).exists():  # python-can would complain about the suffix first
         raise CliError(f"{args.log}: no such file")
     summary = ReplaySummary()

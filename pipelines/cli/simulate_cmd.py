@@ -7,13 +7,17 @@ import sys
 from pathlib import Path
 
 from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, run_closed_loop
-from pipelines.cli.common import CliError, make_out_dir
+from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
 from pipelines.control.controller import controller_names
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
 from pipelines.virtual_camera import VirtualCamera
 from tracker.datasets import load_sequence
 from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers, resolve_name
+
+
+MAX_LATENCY_MS = 2000.0  # far beyond any pipeline worth simulating; a typo must not sleep for hours
+MAX_FPS = 1000.0
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -41,12 +45,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
                         f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND}), "
                         f"or {ORACLE}: the ground-truth box is the detection, isolating the control loop")
-    parser.add_argument("--model-dir", type=Path, metavar="DIR",
+    parser.add_argument("--model-dir", type=existing_dir, metavar="DIR",
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
                         "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: none)")
     parser.add_argument("--fps", type=float, default=30.0, help="playback frame rate (default 30)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
-    parser.add_argument("--out", type=Path, metavar="DIR",
+    parser.add_argument("--out", type=out_dir, metavar="DIR",
                         help="write plot.png and summary.json here (default: none, nothing is written)")
     parser.set_defaults(func=run)
 
@@ -96,8 +100,8 @@ def _view_fov(sequence: Path, size: tuple[int, int], fov: float | None) -> float
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.latency < 0 or args.fps <= 0:
-        raise CliError("--latency must be >= 0 and --fps > 0")
+    if not 0 <= args.latency <= MAX_LATENCY_MS or not 0 < args.fps <= MAX_FPS:
+        raise CliError(f"--latency takes 0 to {MAX_LATENCY_MS:g} ms and --fps above 0 up to {MAX_FPS:g}")
     if args.fov is not None and not 0 < args.fov < 180:
         raise CliError(f"--fov takes 0 < DEG < 180, not {args.fov:g}")
     # The settings name what is used (the resolved tracker, the view's field of view), so the summary does too.

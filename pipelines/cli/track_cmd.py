@@ -15,7 +15,7 @@ from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit
 from pipelines.acquire import PICKS, parse_roi, roi_in_frame
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
-from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, make_out_dir
+from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter, LoggingBus
@@ -52,7 +52,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
                          "is nanotrack when --model-dir holds its files, else dcf)")
-    subject.add_argument("--model-dir", type=Path,
+    subject.add_argument("--model-dir", type=existing_dir,
                          help="folder with optional model files: NanoTrack (then the default tracker) and "
                          "YuNet (then the face detector)")
     control = parser.add_argument_group("control")
@@ -76,11 +76,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="this gimbal turns the other way for positive pitch")
     run = parser.add_argument_group("run")
     run.add_argument("--realtime", action="store_true", help="play files at their own frame rate")
-    run.add_argument("--fps", type=float, help="frame rate of an image folder (default: 30)")
+    run.add_argument("--fps", type=float, help="frame rate of an image folder (default: 30), or a video file's "
+                     "rate overriding its own")
     run.add_argument("--record", action="store_true",
                      help="start camera recording when the subject is acquired, stop it at the end")
     run.add_argument("--max-frames", type=int, help="stop after this many frames")
-    run.add_argument("--out", type=Path, default=Path("out/track"), help="output folder (default: out/track)")
+    run.add_argument("--out", type=out_dir, default=Path("out/track"), help="output folder (default: out/track)")
     run.add_argument("--no-video", action="store_true", help="do not write the annotated video")
     run.add_argument("--video-width", type=int, default=DEFAULT_VIDEO_WIDTH, metavar="PX",
                      help=f"shrink the annotated video to at most this width (default: {DEFAULT_VIDEO_WIDTH}, "
@@ -104,7 +105,9 @@ def _options(args: argparse.Namespace) -> TrackOptions:
     if args.video_width < 0 or args.video_width == 1:
         raise CliError("--video-width takes 0 (full size) or at least 2 pixels")
     if args.fps is not None and not 0 < args.fps < math.inf:
-        raise CliError(f"--fps takes a frame rate above 0, not {args.fps:g}")
+        raise CliError(f"--fps takes a finite frame rate above 0, not {args.fps:g}")
+    if args.hfov is not None and not 0 < args.hfov < 180:
+        raise CliError(f"--hfov takes 0 < DEG < 180, not {args.hfov:g}")
     if args.max_frames is not None and args.max_frames < 1:
         raise CliError("--max-frames must be at least 1")
     detect = args.detect or (None if roi else DEFAULT_DETECTOR)
@@ -132,11 +135,14 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
     with source:
         if options.roi is not None:
             try:
-                options = dataclasses.replace(options, roi=roi_in_frame(options.roi, source.size))
+                roi = roi_in_frame(options.roi, source.size)
             except ValueError as exc:
                 raise CliError(str(exc)) from None
-        make_out_dir(options.out_dir)
+            if roi != options.roi:
+                print(f"gimbaltrack track: note: --roi cut to the frame: {','.join(map(str, roi))}", file=sys.stderr)
+            options = dataclasses.replace(options, roi=roi)
         with open_host_bus(args) as bus:
+            make_out_dir(options.out_dir)
             can_log = _can_log(options.out_dir / "can.log")
             try:
                 with LoggingBus(bus, can_log) as logged, \
@@ -165,8 +171,11 @@ def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, w
         raise CliError(str(exc)) from None
     try:
         session.start()
-    except (KeyboardInterrupt, SystemExit):
-        session.finish("interrupted while starting")
+    except KeyboardInterrupt:
+        session.finish("interrupted while starting (SIGINT)")
+        raise
+    except SignalExit as exc:
+        session.finish(f"terminated while starting ({exc.signal_name})")
         raise
     except GimbalTimeoutError as exc:
         session.finish("gimbal not answering", str(exc))

@@ -58,9 +58,14 @@ def annotate(image: np.ndarray, estimate: TargetEstimate | None = None,
         text.append(f"#{estimate.frame_index} t={estimate.timestamp:.3f}s "
                     f"{estimate.state.value} conf={estimate.confidence:.2f}")
     if rates_dps is not None:
-        text.append(f"yaw {rates_dps[0]:+.1f} pitch {rates_dps[1]:+.1f} deg/s")
+        text.append(rates_text(rates_dps))
     _put_lines(out, [*text, *lines])
     return out
+
+
+def rates_text(rates_dps: tuple[float, float]) -> str:
+    """The commanded rates as the video shows them: ``yaw +12.3 pitch -4.0 deg/s``."""
+    return f"yaw {rates_dps[0]:+.1f} pitch {rates_dps[1]:+.1f} deg/s"
 
 
 def video_size(size: tuple[int, int], max_width: int | None) -> tuple[int, int]:

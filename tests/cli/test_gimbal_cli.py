@@ -207,6 +207,18 @@ def test_can_ids_and_bitrates_are_checked() -> None:
         parse_bitrate("-5")
 
 
+def test_model_and_output_folders_are_checked(tmp_path: Path) -> None:
+    import argparse
+
+    from pipelines.cli.common import existing_dir, out_dir
+
+    assert existing_dir(str(tmp_path)) == tmp_path and out_dir("out/x") == Path("out/x")
+    with pytest.raises(argparse.ArgumentTypeError, match="no such folder"):
+        existing_dir(str(tmp_path / "typo"))  # once quietly "no models"
+    with pytest.raises(argparse.ArgumentTypeError, match="empty path"):
+        out_dir("")  # once the current folder
+
+
 def test_logging_options_also_after_the_command(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["decode", "--hex", "AA", "--verbose"]) == 0
     assert main(["--verbose", "decode", "--hex", "AA"]) == 0

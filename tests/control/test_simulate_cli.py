@@ -54,6 +54,7 @@ def test_model_dir_reaches_the_tracker(sequence: Path, shared_data: Path,
     (["--fov", "0"], "--fov takes 0 < DEG < 180, not 0"),
     (["--tracker", "nanotrack", "--model-dir", "{empty}"], "NanoTrack: no nanotrack_backbone*.onnx in {empty}"),
     (["--fov", "180"], "--fov takes 0 < DEG < 180, not 180"),
+    (["--latency", "inf"], "--latency takes 0 to 2000 ms and --fps above 0 up to 1000"),  # once a traceback
 ])
 def test_bad_options_fail_at_once_in_one_line(argv: list[str], message: str, sequence: Path, tmp_path: Path,
                                               capsys: pytest.CaptureFixture[str]) -> None:

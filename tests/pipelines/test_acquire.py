@@ -49,7 +49,7 @@ def test_pick_central_largest_and_near():
     assert pick_candidate([], SIZE) is None
 
 
-@pytest.mark.parametrize("text", ["1,2,3", "a,b,c,d", "0,0,0,10", "-1,0,5,5"])
+@pytest.mark.parametrize("text", ["1,2,3", "a,b,c,d", "0,0,0,10", "1,0,5,-5"])
 def test_parse_roi_refuses_bad_boxes(text):
     with pytest.raises(ValueError, match="--roi"):
         parse_roi(text)
@@ -62,6 +62,7 @@ def test_parse_roi_reads_a_box():
 def test_roi_in_frame_cuts_a_box_over_the_edge_and_refuses_one_mostly_outside():
     assert roi_in_frame((10, 20, 30, 40), (640, 360)) == (10, 20, 30, 40)
     assert roi_in_frame((600, 300, 60, 60), (640, 360)) == (600, 300, 40, 60)  # 2/3 inside: cut
+    assert roi_in_frame((-10, -20, 60, 60), (640, 360)) == (0, 0, 50, 40)  # over the top left corner too
     with pytest.raises(ValueError, match="mostly outside the 640x360 frame"):
         roi_in_frame((600, 300, 100, 100), (640, 360))
     with pytest.raises(ValueError, match="lies outside"):

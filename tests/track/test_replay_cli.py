@@ -129,3 +129,11 @@ def test_onto_a_bus_only_whole_in_range_packets_go_out(tmp_path: Path, capsys: p
     assert received == packets[0] + packets[4]
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])["summary"]
     assert summary["packets_not_sent"] == {"out_of_range": 2, "undecodable": 1, "truncated": 1}
+
+
+@pytest.mark.parametrize("argv, words", [(["--speed", "inf"], "finite factor"), (["-c", "can0"], "need -i")])
+def test_bad_options_are_one_line_errors(session_log: Path, capsys: pytest.CaptureFixture[str], argv: list[str],
+                                         words: str) -> None:
+    assert main(["replay", str(session_log), *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("gimbaltrack replay: error:") and words in err and err.count("\n") == 1

@@ -45,8 +45,9 @@ def _one_line_error(capsys: pytest.CaptureFixture[str], *words: str) -> str:
     (["--rate", "2"], ["--rate", "4 to 50"]),  # once a traceback from the keep-alive
     (["--rate", "inf"], ["--rate"]),
     (["--roi", "700,400,64,96"], ["--roi", "outside the 640x360 frame"]),  # once tracked the background
-    (["--roi", "138,152,64,96", "-c", "can0"], ["-c/--channel", "need -i"]),  # once the simulator, silently
+    (["--roi", "138,152,64,96", "-c", "can0"], ["-c/--channel", "give -i"]),  # once the simulator, silently
     (["--roi", "138,152,64,96", "--fps", "-3"], ["--fps"]),  # once a traceback
+    (["--roi", "138,152,64,96", "--hfov", "0"], ["--hfov takes 0 < DEG < 180"]),
     (["--roi", "138,152,64,96", "--out", str(ROOT / "README.md")], ["is a file, not a folder"]),
 ])
 def test_bad_options_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str],
