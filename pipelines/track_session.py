@@ -132,6 +132,8 @@ class TrackSession:
         self.paths = {"telemetry": out / "telemetry.jsonl", "can_log": out / "can.log",
                       "summary": out / "summary.json", "plot": out / "plot.png"}
         self.telemetry = TelemetryWriter(self.paths["telemetry"])
+        for stale in (self.paths["plot"], out / "annotated.avi"):  # an earlier run's, which this one may not rewrite
+            stale.unlink(missing_ok=True)
         self.video: BackgroundVideoWriter | None = None
         if options.video:
             self.paths["video"] = out / "annotated.avi"

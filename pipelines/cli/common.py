@@ -66,8 +66,9 @@ def parse_bitrate(text: str) -> int:
 
 
 def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | None = None,
-                    repeated: bool = False) -> None:
+                    repeated: bool = False, offers_sim: bool = True) -> None:
     """python-can's own options; unset values fall back to can.rc, CAN_* variables and ~/.canrc.
+    ``offers_sim``: ``-i sim`` (the built-in simulated gimbal) is one of the choices.
 
     ``repeated`` adds them again to a command whose parent parser has them already: given there
     they win, left out they keep the parent's value (``gimbal -i sim angles`` = ``gimbal angles -i sim``).
@@ -75,15 +76,15 @@ def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | No
     group = parser.add_argument_group("CAN bus (python-can conventions)")
     group.add_argument(
         "-i", "--interface", default=default_interface,
-        help="python-can interface (socketcan, slcan, pcan, kvaser, gs_usb, virtual, udp_multicast, ...) "
-        "or 'sim' for the built-in simulated gimbal"
+        help="python-can interface (socketcan, slcan, pcan, kvaser, gs_usb, virtual, udp_multicast, ...)"
+        + (" or 'sim' for the built-in simulated gimbal" if offers_sim else "")
         + (f" (default: {default_interface})" if default_interface else
            " (default: python-can's configuration)"),
     )
     group.add_argument("-c", "--channel", help="channel, e.g. can0, /dev/ttyACM0, PCAN_USBBUS1, a multicast "
-                       "group (with -i only)")
+                       "group (not with the simulated gimbal)")
     group.add_argument("-b", "--bitrate", type=parse_bitrate,
-                       help="bitrate in bit/s (DJI RS gimbals use 1000000; with -i only)")
+                       help="bitrate in bit/s (DJI RS gimbals use 1000000; not with the simulated gimbal)")
     group.add_argument("--tx-id", type=parse_can_id, default=0x223, help="CAN id the host sends on (default 0x223)")
     group.add_argument("--rx-id", type=parse_can_id, default=0x222, help="CAN id the host listens on (default 0x222)")
     if repeated:

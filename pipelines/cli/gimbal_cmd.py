@@ -465,7 +465,7 @@ COMMANDS = [
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser("gimbal", help="talk to a DJI RS gimbal: read, move, set, camera",
-                                   description=__doc__)
+                                   description=__doc__.replace("``", "'"))
     _shared_options(parser)
     commands = parser.add_subparsers(dest="gimbal_command", metavar="COMMAND", required=True)
     for command in COMMANDS:

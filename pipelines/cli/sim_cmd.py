@@ -25,7 +25,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "udp_multicast and drive it from another process, e.g. "
         "'gimbaltrack sim -i udp_multicast -c 239.74.163.2'. The id options keep the host's point of "
         "view: the simulator listens on --tx-id and answers on --rx-id.")
-    add_bus_options(parser, default_interface="udp_multicast")
+    add_bus_options(parser, default_interface="udp_multicast", offers_sim=False)
     model = parser.add_argument_group("device")
     model.add_argument("--legacy", action="store_true", help="old firmware: replies omit CmdSet/CmdID")
     model.add_argument("--push-rate", type=float, default=SimConfig.push_rate_hz, metavar="HZ",

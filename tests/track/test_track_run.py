@@ -198,3 +198,12 @@ def test_a_file_cut_short_ends_with_a_warning(tmp_path: Path, capsys: pytest.Cap
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["frames_expected"] == 270 and 0 < summary["frames"] < 0.95 * 270
     assert f"ended after {summary['frames']} of the 270 frames" in capsys.readouterr().err
+
+
+def test_a_run_into_an_earlier_runs_folder_leaves_none_of_its_outputs(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--max-frames", "5") == 0
+    assert (out / "annotated.avi").exists() and (out / "plot.png").exists()
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--max-frames", "5", "--no-video") == 0
+    assert not (out / "annotated.avi").exists()  # not a stale video beside the new run's outputs
+    assert len(read_telemetry(out / "telemetry.jsonl")) == 5
