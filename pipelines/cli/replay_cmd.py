@@ -18,12 +18,9 @@ from typing import Any, TextIO
 import can
 
 from gimbal.client import stop_messages
-from gimbal.errors import PayloadError, RangeError
-from gimbal.framer import Dropped, PacketFramer
 from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
-from gimbal.messages import decode_message, message_packet
+from gimbal.messages import message_packet
 from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
-from gimbal.packet import Packet
 from gimbal.transport import CanTransport, packet_frames
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
@@ -163,42 +160,25 @@ def _field(name: str, value: Any, record: Record) -> str:
     return f"{name}={value}"
 
 
-class _HostPackets:
-    """Host frames bound for a bus, held until they make up a whole packet that decodes to a
-    message of the document with every value in its range: only such packets go out (their own
-    bytes, cut into frames as recorded), so a foreign or corrupt log never puts an out-of-range
-    value or a broken packet on a gimbal's bus."""
-
-    def __init__(self, summary: ReplaySummary) -> None:
-        self._framer = PacketFramer()
-        self._summary = summary
-
-    def feed(self, data: bytes) -> list[bytes]:
-        """The raw bytes of each packet ``data`` completes that may be sent."""
-        ready = []
-        for item in self._framer.feed(data):
-            reason = item.reason if isinstance(item, Dropped) else _refusal(item)
-            if reason is None:
-                ready.append(item.raw)
-            else:
-                self._summary.not_sent[reason] += 1
-        return ready
-
-    def finish(self) -> None:
-        """End of the log: a packet left incomplete is counted, never sent."""
-        for dropped in self._framer.flush():
-            self._summary.not_sent[dropped.reason] += 1
+#: The decoder's errors for a whole packet that does not decode (the framer's own reasons, such as
+#: ``truncated`` or ``crc16``, are kept as they are).
+_UNDECODABLE = {"unknown_command", "bad_payload", "unmatched_legacy_reply"}
 
 
-def _refusal(packet: Packet) -> str | None:
-    """Why a framed host packet must not be sent, or None."""
-    try:
-        decode_message(packet).validate()
-    except RangeError:
-        return "out_of_range"
-    except PayloadError:
-        return "undecodable"
-    return None
+def _send_host_packets(records: list[Record], bus: can.BusABC, tx_id: int, summary: ReplaySummary) -> None:
+    """Send the host packets among the decoder's ``records`` that decoded to a message of the
+    document with every value in its range (their own bytes, cut into frames as recorded); count
+    the others in ``summary.not_sent`` by reason. A foreign or corrupt log thus never puts an
+    out-of-range value or a broken packet on a gimbal's bus."""
+    for record in records:
+        if record["direction"] != HOST_TO_GIMBAL:
+            continue
+        if "error" in record:
+            summary.not_sent["undecodable" if record["error"] in _UNDECODABLE else record["error"]] += 1
+        elif "out_of_range" in record:
+            summary.not_sent["out_of_range"] += 1
+        else:
+            summary.frames_sent += _send(bus, bytes.fromhex(record["hex"]), tx_id)
 
 
 class _Pacer:
@@ -271,7 +251,6 @@ def _settled(sim: Any) -> Any:
 def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | None, out: TextIO) -> None:
     decoder = LogDecoder(args.tx_id, args.rx_id)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
-    outgoing = _HostPackets(summary)
     skip_echoes = _marks_sent_frames(args.log, args.tx_id)
     with closing(iter_log_frames(args.log, "replay")) as frames:
         for frame in frames:
@@ -283,13 +262,14 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
             summary.last_t = frame.timestamp
             if pacer is not None:
                 pacer.wait(frame.timestamp)
-            if bus is not None and frame.arbitration_id == args.tx_id and not frame.is_extended_id:
-                for raw in outgoing.feed(bytes(frame.data)):
-                    summary.frames_sent += _send(bus, raw, args.tx_id)
-            _emit(decoder.feed_frame(frame), summary, args.json, out)
-    if bus is not None:
-        outgoing.finish()
-    _emit(decoder.finish(summary.last_t), summary, args.json, out)
+            records = decoder.feed_frame(frame)
+            if bus is not None:
+                _send_host_packets(records, bus, args.tx_id, summary)
+            _emit(records, summary, args.json, out)
+    records = decoder.finish(summary.last_t)
+    if bus is not None:  # a host packet left incomplete is counted, never sent
+        _send_host_packets(records, bus, args.tx_id, summary)
+    _emit(records, summary, args.json, out)
 
 
 def _marks_sent_frames(path: str, tx_id: int) -> bool:
