@@ -11,7 +11,7 @@ from __future__ import annotations
 import time
 from collections import deque
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -53,7 +53,7 @@ class LoopStep:
 
 @dataclass
 class LoopResult:
-    settings: LoopSettings
+    settings: LoopSettings  # as used: the tracker's resolved name, the view's field of view
     steps: list[LoopStep]
     summary: dict[str, float | int | None]
     command_latencies: list[float]  # capture -> first send on the bus, seconds
@@ -151,5 +151,6 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
     finally:
         sim.stop()
         host_bus.shutdown()
-    return LoopResult(settings, steps, summarize([s.sample for s in steps]), latencies)
+    used = replace(settings, tracker=ORACLE if subject is None else subject.name, hfov_deg=vc.camera.hfov_deg)
+    return LoopResult(used, steps, summarize([s.sample for s in steps]), latencies)
 

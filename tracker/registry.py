@@ -24,18 +24,12 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None) -> 
     ``default`` picks NanoTrack when ``model_dir`` holds its files, else the correlation filter.
     Unknown names raise ``ValueError``; missing model files raise ``FileNotFoundError``.
     """
-    name = resolve_name(name, model_dir)
+    if name == "default":
+        name = DEFAULT_WITH_MODELS if model_dir is not None and _has_nanotrack(model_dir) else DEFAULT_BACKEND
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
     backend = make_backend(name, model_dir)  # missing model files fail here, not on init()
     return SubjectTracker(name, backend, settings=_SETTINGS.get(name))
-
-
-def resolve_name(name: str = "default", model_dir: str | Path | None = None) -> str:
-    """The tracker ``make_tracker(name, model_dir)`` builds: ``default`` resolved, any other name as given."""
-    if name != "default":
-        return name
-    return DEFAULT_WITH_MODELS if model_dir is not None and _has_nanotrack(model_dir) else DEFAULT_BACKEND
 
 
 def _has_nanotrack(model_dir: str | Path) -> bool:

@@ -11,9 +11,7 @@ from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
 from pipelines.control.controller import controller_names
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
-from pipelines.virtual_camera import VirtualCamera
-from tracker.datasets import load_sequence
-from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers, resolve_name
+from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers
 
 
 MAX_LATENCY_MS = 2000.0  # far beyond any pipeline worth simulating; a typo must not sleep for hours
@@ -89,27 +87,15 @@ def write_plot(path: Path, result: LoopResult) -> None:
         ylabels=["fraction of diagonal", "deg/s"])
 
 
-def _view_fov(sequence: Path, size: tuple[int, int], fov: float | None) -> float:
-    """The view's horizontal field of view: ``fov``, or the crop-equivalent one for ``sequence``'s frames."""
-    if fov is not None:
-        return fov
-    first = next(load_sequence(sequence).frames(), None)
-    if first is None:
-        raise ValueError(f"{sequence}: no frames")
-    return VirtualCamera((first.shape[1], first.shape[0]), size).camera.hfov_deg
-
-
 def run(args: argparse.Namespace) -> int:
     if not 0 <= args.latency <= MAX_LATENCY_MS or not 0 < args.fps <= MAX_FPS:
         raise CliError(f"--latency takes 0 to {MAX_LATENCY_MS:g} ms and --fps above 0 up to {MAX_FPS:g}")
     if args.fov is not None and not 0 < args.fov < 180:
         raise CliError(f"--fov takes 0 < DEG < 180, not {args.fov:g}")
-    # The settings name what is used (the resolved tracker, the view's field of view), so the summary does too.
-    tracker = args.tracker if args.tracker == ORACLE else resolve_name(args.tracker, args.model_dir)
+    settings = LoopSettings(controller=args.controller, tracker=args.tracker, hfov_deg=args.fov,
+                            out_size=args.size, latency_s=args.latency / 1000.0, fps=args.fps,
+                            model_dir=args.model_dir)
     try:
-        settings = LoopSettings(controller=args.controller, tracker=tracker,
-                                hfov_deg=_view_fov(args.sequence, args.size, args.fov), out_size=args.size,
-                                latency_s=args.latency / 1000.0, fps=args.fps, model_dir=args.model_dir)
         if args.out:
             make_out_dir(args.out)
         result = run_closed_loop(args.sequence, settings)
@@ -128,8 +114,9 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
         return 0
     ttc = summary["time_to_first_centre"]
-    print(f"{result.summary['frames']} frames, controller {settings.controller}, tracker {settings.tracker}, "
-          f"view {args.size[0]}x{args.size[1]} at {settings.hfov_deg:.1f} deg, "
+    used = result.settings  # the tracker's resolved name, the view's field of view
+    print(f"{result.summary['frames']} frames, controller {used.controller}, tracker {used.tracker}, "
+          f"view {args.size[0]}x{args.size[1]} at {used.hfov_deg:.1f} deg, "
           f"+{args.latency:g} ms latency (capture to bus, median {summary['median_capture_to_bus_ms']:.0f} ms)")
     print(f"centring error (fraction of diagonal): mean {summary['mean_center_error']:.4f}, "
           f"RMS {summary['rms_center_error']:.4f}")
