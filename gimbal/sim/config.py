@@ -15,7 +15,7 @@ class SimConfig:
     tx_id: int = HOST_RX_ID  # and answers where the host listens (0x222)
     legacy: bool = False  # old firmware: replies omit CmdSet/CmdID
     push_rate_hz: float = 50.0  # parameter push (0x08) rate once enabled
-    tick_hz: float = 200.0  # dynamics integration rate
+    tick_hz: float = 200.0  # the grain of injected foreign traffic (everything else is sent when due)
     max_speed_dps: float = 360.0
     accel_dps2: float = 720.0  # speed changes (speed control, joystick, stops) are rate-limited
     speed_timeout_s: float = 0.5  # the document's 0.5 s rule

@@ -1,5 +1,5 @@
 """The simulated gimbal on a CAN bus: a receive thread answering commands and a tick thread
-integrating the axes, sending pushes and delayed replies, and adding foreign traffic."""
+sending pushes and delayed replies when they are due, and adding foreign traffic."""
 from __future__ import annotations
 
 import heapq
@@ -30,7 +30,8 @@ PARSE_ERROR_PAYLOAD = b"\x01"
 
 class SimulatedGimbal:
     """A DJI RS gimbal answering the R SDK on ``bus`` (listens on ``config.rx_id``, answers on
-    ``config.tx_id``). ``clock`` drives the model; threads pace themselves in real time."""
+    ``config.tx_id``). ``clock`` drives the model; it must run at the real rate (the tick thread
+    sleeps for the clock's seconds until the next push is due)."""
 
     def __init__(self, bus: can.BusABC, config: SimConfig = SimConfig(), faults: Faults = Faults(),
                  clock: Callable[[], float] = time.monotonic, *, shutdown_bus: bool = False) -> None:
@@ -50,6 +51,8 @@ class SimulatedGimbal:
         self._push_seq = 0
         self._started_at = 0.0
         self._stop = threading.Event()
+        self._wake = threading.Event()  # something is due before the tick thread meant to wake
+        self._sleep_until: float | None = None  # when it means to wake (None: when woken)
         self._threads: list[threading.Thread] = []
 
     def start(self) -> SimulatedGimbal:
@@ -66,6 +69,7 @@ class SimulatedGimbal:
     def stop(self) -> None:
         """Stop both threads (and shut the bus down if this gimbal owns it)."""
         self._stop.set()
+        self._wake.set()
         for thread in self._threads:
             thread.join(timeout=2.0)
         if self._shutdown_bus:
@@ -142,6 +146,7 @@ class SimulatedGimbal:
             return
         code = self._injector.nack()
         reply = self._model.handle(message, now) if code is None else self._model.refuse(message, code)
+        self._wake_if_sooner()  # e.g. the push turned on, a calibration started
         if wants_reply:
             self._queue(message_packet(reply, packet.seq, legacy=self._legacy()), reply.NAME, now)
 
@@ -157,6 +162,7 @@ class SimulatedGimbal:
             return
         self._injector.counts["delayed_replies"] += 1
         heapq.heappush(self._delayed, (now + self.faults.delay_s, id(packet), packet, name))
+        self._wake_if_sooner()
 
     def _send(self, packet: Packet, name: str, now: float) -> None:
         if self._injector.silent(now - self._started_at):
@@ -185,22 +191,40 @@ class SimulatedGimbal:
     # --- tick ---------------------------------------------------------------------------------
 
     def _tick_loop(self) -> None:
-        period = 1.0 / self.config.tick_hz
-        next_tick = time.monotonic()
+        """Sleep until something is due (a push, a delayed reply, the next grain of foreign
+        traffic) or a command brings that forward, then send what is due. The model is exact at
+        any time, so there is nothing to do in between."""
+        grain = 1.0 / self.config.tick_hz
         last = self.clock()
-        while not self._stop.wait(max(0.0, next_tick - time.monotonic())):
-            next_tick = max(next_tick + period, time.monotonic() - period)
+        while not self._stop.is_set():
             now = self.clock()
             with self._lock:
+                self._wake.clear()
                 for push in self._model.advance(now):
                     self._push(push, now)
                 while self._delayed and self._delayed[0][0] <= now:
                     _, _, packet, name = heapq.heappop(self._delayed)
                     self._send(packet, name, now)
                 foreign = self._injector.foreign_frames(max(0.0, now - last))
+                due = [t for t in (self._next_due(), now + grain if self.faults.foreign_rate > 0 else None)
+                       if t is not None]
+                self._sleep_until = min(due, default=None)
+                until = self._sleep_until
             last = now
             if foreign:
                 self._bus_send([can.Message(arbitration_id=i, is_extended_id=False, data=d) for i, d in foreign])
+            self._wake.wait(None if until is None else max(0.0, until - self.clock()))
+
+    def _next_due(self) -> float | None:
+        """When the next push or delayed reply is due (lock held)."""
+        due = [t for t in (self._model.next_due(), self._delayed[0][0] if self._delayed else None) if t is not None]
+        return min(due, default=None)
+
+    def _wake_if_sooner(self) -> None:
+        """Wake the tick thread when something is now due before it means to wake (lock held)."""
+        due = self._next_due()
+        if due is not None and (self._sleep_until is None or due < self._sleep_until):
+            self._wake.set()
 
 
 def start_in_process(config: SimConfig | None = None, faults: Faults | None = None) -> tuple[can.BusABC, SimulatedGimbal]:

@@ -59,12 +59,15 @@ class FocusMotor:
         return False
 
     def advance(self, now: float) -> None:
+        """Integrate from the previous call to ``now`` (split exactly where a dial push expires)."""
+        if self._dial and self._last is not None and self._last < self._dial_until < now:
+            self.advance(self._dial_until)
         dt = 0.0 if self._last is None else max(0.0, now - self._last)
         self._last = now
         if self.state == FOCUS_CALIBRATING and now >= self._calibration_done_at:
             self.state = FOCUS_CALIBRATED
             self.travel = (float(FOCUS_POSITION_RANGE[0]), float(FOCUS_POSITION_RANGE[1]))
-        if self._dial and now < self._dial_until:
+        if self._dial and now <= self._dial_until:
             self.target = self._clamp(self.position + self._dial * dt)
         step = self.speed * dt
         self.position += max(-step, min(step, self.target - self.position))

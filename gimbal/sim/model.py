@@ -27,7 +27,9 @@ DIAL_FULL_SCALE = external.DIAL_RANGE[1]
 
 class GimbalModel:
     """The device's state and behaviour. ``handle`` answers commands, ``apply_push`` takes host
-    pushes, ``advance`` integrates the axes and returns the device pushes due."""
+    pushes, ``advance`` returns the device pushes due and ``next_due`` says when the next one is.
+    Each of them (and ``snapshot``) first integrates the axes up to its ``now``, so the state is
+    exact whenever it is looked at, however rarely ``advance`` is called."""
 
     def __init__(self, config: SimConfig, now: float) -> None:
         self.config = config
@@ -53,6 +55,8 @@ class GimbalModel:
         self._calibration_started = 0.0
         self._next_calibration_push = 0.0
         self._next_push = now
+        self._integrated_to = now
+        self._due_pushes: list[Message] = []  # raised by integration (calibration done), sent by advance
         self._handlers: dict[type[Message], Callable[[Any, float], Reply]] = {
             motion.PositionControl: self._position, motion.SpeedControl: self._speed,
             motion.GetAngles: self._get_angles, settings.SetAngleLimits: self._set_limits,
@@ -77,11 +81,13 @@ class GimbalModel:
 
     def handle(self, message: Message, now: float) -> Reply:
         """Execute a host command and return its reply."""
+        self._integrate(now)
         self.commands[message.NAME] += 1
         return self._handlers[type(message)](message, now)
 
     def apply_push(self, message: Message, now: float) -> None:
         """Take a host push (never answered)."""
+        self._integrate(now)
         self.commands[message.NAME] += 1
         self._pushes[type(message)](message, now)
 
@@ -129,26 +135,41 @@ class GimbalModel:
 
     def advance(self, now: float) -> list[Message]:
         """Integrate up to ``now``; return the device pushes due (parameter, calibration)."""
-        for name, axis in self.axes.items():
-            axis.advance(now, self.axis_range(name))
-        self.focus.advance(now)
-        pushes: list[Message] = []
-        if self.calibration[0] == CALIBRATION_RUNNING:
-            elapsed = now - self._calibration_started
-            if elapsed >= self.config.calibration_s:
-                self.calibration = (CALIBRATION_DONE, 100)
-                pushes.append(tlv_params.CalibrationStatusPush.of(CALIBRATION_DONE, 100))
-            else:
-                progress = min(99, int(100 * elapsed / self.config.calibration_s))
-                self.calibration = (CALIBRATION_RUNNING, progress)
-                if now >= self._next_calibration_push:
-                    pushes.append(tlv_params.CalibrationStatusPush.of(*self.calibration))
-                    self._next_calibration_push += 1.0 / self.config.calibration_push_hz
+        self._integrate(now)
+        pushes, self._due_pushes = self._due_pushes, []
+        if self.calibration[0] == CALIBRATION_RUNNING and now >= self._next_calibration_push:
+            pushes.append(tlv_params.CalibrationStatusPush.of(*self.calibration))
+            self._next_calibration_push += 1.0 / self.config.calibration_push_hz
         if self.push_enabled and now >= self._next_push:
             pushes.append(self.parameter_push())
             period = 1.0 / self.config.push_rate_hz
             self._next_push = max(self._next_push + period, now - period / 2)
         return pushes
+
+    def next_due(self) -> float | None:
+        """When ``advance`` will next have a push to return (None: none is scheduled)."""
+        times = [self._next_push] if self.push_enabled else []
+        if self._due_pushes:
+            times.append(self._integrated_to)
+        if self.calibration[0] == CALIBRATION_RUNNING:
+            times += [self._next_calibration_push, self._calibration_started + self.config.calibration_s]
+        return min(times, default=None)
+
+    def _integrate(self, now: float) -> None:
+        """Bring the axes, the focus motor and the auto-calibration up to ``now``."""
+        if now < self._integrated_to:
+            return
+        self._integrated_to = now
+        for name, axis in self.axes.items():
+            axis.advance(now, self.axis_range(name))
+        self.focus.advance(now)
+        if self.calibration[0] == CALIBRATION_RUNNING:
+            elapsed = now - self._calibration_started
+            if elapsed >= self.config.calibration_s:
+                self.calibration = (CALIBRATION_DONE, 100)
+                self._due_pushes.append(tlv_params.CalibrationStatusPush.of(CALIBRATION_DONE, 100))
+            else:
+                self.calibration = (CALIBRATION_RUNNING, min(99, int(100 * elapsed / self.config.calibration_s)))
 
     def parameter_push(self) -> telemetry.ParameterPush:
         att, joint = self.attitude(), self.joint()
@@ -352,6 +373,7 @@ class GimbalModel:
     # --- snapshot -----------------------------------------------------------------------------
 
     def snapshot(self, now: float, sent: Counter[str], faults: Counter[str]) -> SimState:
+        self._integrate(now)
         return SimState(
             time=now, attitude=self.attitude(), joint=self.joint(),
             speeds=tuple(self.axes[n].velocity for n in AXES),  # type: ignore[arg-type]

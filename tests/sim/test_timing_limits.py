@@ -2,11 +2,12 @@
 from __future__ import annotations
 
 import time
+from collections import Counter
 
 import pytest
 
 from gimbal.errors import ReturnCodeError
-from gimbal.messages import motion, telemetry
+from gimbal.messages import external, motion, telemetry
 from gimbal.sim import SimConfig
 from gimbal.sim.dynamics import Axis, AxisRange
 from gimbal.sim.model import GimbalModel
@@ -116,3 +117,34 @@ def test_axis_acceleration_and_expiry_are_exact() -> None:
     axis.advance(0.6, free)
     assert axis.velocity == 0.0 and axis.mode.value == "hold"
     assert axis.angle == pytest.approx(0.5 * 72.0 * 0.1 + 72.0 * 0.4 + 0.5 * 72.0 * 0.1)
+
+
+def test_the_model_is_exact_whenever_it_is_asked_without_being_advanced() -> None:
+    """Commands and queries integrate up to their own time first: a speed command after an idle
+    second does not move the gimbal over that second, and a query sees the motion since."""
+    model = GimbalModel(SimConfig(), 0.0)
+    assert model.handle(motion.SpeedControl(yaw_speed=100), 1.0).ok  # 10 °/s yaw
+    reply = model.handle(motion.GetAngles(motion.ANGLES_JOINT), 1.4)
+    ramp = 10.0 / 720.0  # seconds to reach 10 °/s
+    assert reply.yaw == round(10 * (0.4 - ramp / 2) * 10)  # 0.1° units: not 0, and not over 1.4 s
+    assert model.snapshot(1.9, Counter(), Counter()).speeds[0] == 0.0  # expired at 1.5 s, decelerated
+
+
+def test_a_dial_push_drives_the_focus_for_its_half_second_exactly() -> None:
+    model = GimbalModel(SimConfig(focus_speed=1000.0), 0.0)
+    model.apply_push(external.DialPush(dial_speed=1024), 0.0)  # half speed for 0.5 s
+    model.advance(2.0)  # one long step past the push's expiry
+    assert model.focus.position == pytest.approx(250.0)
+
+
+def test_the_tick_thread_sleeps_until_something_is_due(make_client) -> None:
+    """An idle simulator does not poll; with the push on it wakes about once a push."""
+    client, sim = make_client()
+    calls = []
+    advance = sim._model.advance
+    sim._model.advance = lambda now: calls.append(now) or advance(now)  # type: ignore[method-assign]
+    time.sleep(0.5)
+    assert len(calls) <= 2, len(calls)  # was 100 at the 200 Hz tick
+    client.set_push(True)
+    time.sleep(0.5)
+    assert 20 <= len(calls) <= 32, len(calls)  # 25 pushes at 50 Hz, plus the wake for the command
