@@ -9,7 +9,8 @@ Replies are matched to requests by SEQ when the gimbal echoes it, otherwise by C
 once the gimbal has echoed a SEQ, a reply with an unknown SEQ is stale.
 A retry resends the *same* packet with the same SEQ, so a late reply to any attempt completes the
 call. Commands whose repetition changes the outcome (relative moves, toggles, camera actions)
-are never retried. Replies that match no outstanding request are counted in ``stats`` and dropped.
+are never retried. Replies that match no outstanding request (``stale_replies``), or are too short
+to name the command they answer (``bad_replies``), are counted in ``stats`` and dropped.
 """
 from __future__ import annotations
 
@@ -27,8 +28,8 @@ import can
 
 from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError, ReturnCodeError
 from gimbal.framer import Dropped
-from gimbal.messages import (Message, Reply, decode_message, is_device_push, is_legacy_reply,
-                             message_packet)
+from gimbal.messages import (Message, PayloadError, Reply, decode_message, is_device_push,
+                             message_packet, reply_key)
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, FocusPositionReply,
@@ -46,7 +47,7 @@ from gimbal.messages.tlv_params import (AutoCalibration, GetUserParams, SetUserP
                                         autotune)
 from gimbal.packet import REPLY_OPTIONAL, Packet, encode_packet
 from gimbal.pushes import PushCallback, PushHub
-from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport
+from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport, with_default_bitrate
 
 if TYPE_CHECKING:
     from gimbal.keepalive import SpeedStreamer
@@ -55,6 +56,7 @@ log = logging.getLogger(__name__)
 
 FIRST_SEQ = 0x1122  # DJI's demo starts here
 RX_POLL_S = 0.05  # how often the receive thread looks at the closing flag
+MAX_TIMEOUT = threading.TIMEOUT_MAX  # longer waits overflow the platform's time_t
 ANGLE_KINDS = {"attitude": ANGLES_ATTITUDE, "joint": ANGLES_JOINT}
 FOLLOW_MODES = {"lock": FOLLOW_LOCK, "yaw": FOLLOW_YAW, "fpv": FOLLOW_FPV}
 ORIENTATIONS = {"keep": 0x00, "landscape": 0x01, "landscape-flipped": 0x02, "portrait": 0x03,
@@ -150,19 +152,20 @@ class GimbalClient:
 
     ``bus`` may be any ``can.BusABC``; without one, ``can.Bus(**bus_kwargs)`` is built from
     python-can's own configuration (``interface=``, ``channel=``, can.rc, ``CAN_*`` variables,
-    ``~/.canrc``) and shut down on close. Use as a context manager: leaving it sends zero speed and
-    releases speed control if this client took it.
+    ``~/.canrc``), at the document's 1 Mbit/s unless a bitrate is given or configured, and shut
+    down on close. Use as a context manager: leaving it sends zero speed and releases speed
+    control if this client took it.
     """
 
     def __init__(self, bus: can.BusABC | None = None, *, tx_id: int = HOST_TX_ID,
                  rx_id: int = HOST_RX_ID, timeout: float = 0.1, retries: int = 2,
                  **bus_kwargs: Any) -> None:
-        if timeout <= 0 or retries < 0:
-            raise ValueError("timeout must be > 0 and retries >= 0")
+        if not 0 < timeout <= MAX_TIMEOUT or retries < 0:
+            raise ValueError(f"timeout must be above 0 and at most {MAX_TIMEOUT:.0f} s, and retries >= 0")
         self._owns_bus = bus is None
         if bus is None:
             try:
-                bus = can.Bus(**bus_kwargs)
+                bus = can.Bus(**with_default_bitrate(bus_kwargs))
             except (can.CanError, OSError, ValueError, ImportError) as exc:
                 raise BusError(f"cannot open the CAN bus: {exc}") from exc
         elif bus_kwargs:
@@ -287,7 +290,12 @@ class GimbalClient:
             self.stats["pushes"] += 1
             self.pushes.deliver(message, t)
         elif packet.is_reply:
-            waiter = self._match(packet)
+            try:
+                waiter = self._match(packet)
+            except PayloadError as exc:
+                self.stats["bad_replies"] += 1
+                log.warning("undecodable reply: %s", exc)
+                return
             if waiter is None:
                 self.stats["stale_replies"] += 1
                 log.debug("reply SEQ 0x%04X matches no outstanding request", packet.seq)
@@ -301,10 +309,11 @@ class GimbalClient:
 
         By SEQ first. Until the gimbal has been seen echoing SEQs, a reply whose SEQ matches
         nothing goes to the oldest request with its CmdSet/CmdID (latest layout) or to the oldest
-        request (legacy layout); once echoing is seen, such a reply is stale.
+        request (legacy layout); once echoing is seen, such a reply is stale. Raises
+        ``PayloadError`` for a reply too short to say which command it answers.
         """
-        legacy = is_legacy_reply(packet)
-        key = None if legacy else (packet.data[0], packet.data[1])
+        key = reply_key(packet)
+        legacy = key is None
         with self._lock:
             waiter = self._pending.get(packet.seq)
             if waiter is not None and (legacy or waiter.key == key):

@@ -1,7 +1,7 @@
 """Bytes in any chunking -> whole packets; resyncs on garbage, truncation and CRC failures."""
 from __future__ import annotations
 
-from collections import Counter
+from collections import Counter, deque
 from dataclasses import dataclass
 
 from gimbal.crc import crc16, crc32
@@ -21,10 +21,16 @@ class Dropped:
 
 
 class PacketFramer:
-    """Reassembles packets from a byte stream. ``feed`` never raises on bad input."""
+    """Reassembles packets from a byte stream. ``feed`` never raises on bad input.
+
+    Feed one source either with ``feed`` (a stream in any chunking) or with ``feed_frame`` (whole
+    CAN frames, which lets the framer use their boundaries), not both.
+    """
 
     def __init__(self, max_buffer: int = DEFAULT_MAX_BUFFER) -> None:
         self._buffer = bytearray()
+        self._base = 0  # stream offset of the buffer's first byte
+        self._frame_starts: deque[int] = deque()  # stream offsets of the frames in the buffer
         self._scanned = 1  # offsets 1.._scanned-1 of the buffer cannot start a packet
         self._header_ok = False  # the header at the front of the buffer passed its CRC16
         self._max_buffer = max(max_buffer, 1024)
@@ -40,6 +46,17 @@ class PacketFramer:
             out.append(self._drop("overflow", len(self._buffer)))
         return out
 
+    def feed_frame(self, data: bytes) -> list[Packet | Dropped]:
+        """Add one CAN frame's bytes; like ``feed``, and packets start at a frame's first byte.
+
+        A packet whose last frame was lost can still pass its CRC32 when the next packet's first
+        bytes equal the lost ones (a final byte 0xAA, say). It then ends inside that packet's
+        first frame, and those bytes are left to start the next packet instead of being lost
+        with it.
+        """
+        self._frame_starts.append(self._base + len(self._buffer))
+        return self.feed(data)
+
     def flush(self) -> list[Dropped]:
         """End of stream: whatever is left is truncated (one drop per packet start found in it)."""
         out = []
@@ -54,11 +71,38 @@ class PacketFramer:
 
     def _drop(self, reason: str, count: int) -> Dropped:
         dropped = Dropped(reason, bytes(self._buffer[:count]))
-        del self._buffer[:count]
-        self._scanned = 1
-        self._header_ok = False
+        self._discard(count)
         self.stats[reason] += count
         return dropped
+
+    def _discard(self, count: int) -> None:
+        """Remove the first ``count`` bytes of the buffer."""
+        del self._buffer[:count]
+        self._base += count
+        while self._frame_starts and self._frame_starts[0] < self._base:
+            self._frame_starts.popleft()
+        self._scanned = 1
+        self._header_ok = False
+
+    def _packet_end(self, length: int) -> int:
+        """How many bytes the valid packet of ``length`` at the front of the buffer takes:
+        ``length``, unless it began a frame (``feed_frame``) and ends inside a later frame where
+        a packet can start. That frame's leading bytes stood in for the packet's lost last frame,
+        and belong to the next packet."""
+        buf = self._buffer
+        starts = self._frame_starts
+        if length == len(buf) or not starts or starts[0] != self._base:
+            return length  # ends with the last frame; or fed as a stream, or not frame-aligned
+        frame_end = len(buf)
+        for start in reversed(starts):
+            offset = start - self._base
+            if offset < length:  # the frame holding the packet's last byte
+                if 0 < offset and length < frame_end and buf[offset] == SOF \
+                        and self._header_at(offset) is not False:
+                    return offset
+                return length
+            frame_end = offset
+        return length
 
     def _step(self, out: list[Packet | Dropped]) -> bool:
         """Consume one packet or one drop from the front of the buffer; False = need more bytes."""
@@ -98,9 +142,7 @@ class PacketFramer:
         except PacketError as exc:  # "encrypted"
             out.append(self._drop(exc.reason, length))
             return True
-        del buf[:length]
-        self._scanned = 1
-        self._header_ok = False
+        self._discard(self._packet_end(length))
         self.stats["packets"] += 1
         out.append(packet)
         return True

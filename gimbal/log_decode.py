@@ -21,7 +21,7 @@ import can
 from gimbal.errors import PayloadError, RangeError, UnknownMessageError, describe_return_code
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.messages import Kind, Message, decode_message, is_device_push, is_legacy_reply
-from gimbal.packet import Packet, encode_packet
+from gimbal.packet import NO_REPLY, Packet, encode_packet
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 
 HOST_TO_GIMBAL = "host->gimbal"
@@ -56,7 +56,7 @@ class LogDecoder:
     Frames on ``tx_id`` are host -> gimbal, frames on ``rx_id`` gimbal -> host, other ids are
     counted in ``foreign_frames`` and ignored. Legacy-layout replies (no CmdSet/CmdID) are
     resolved against the commands seen in the other direction: same SEQ first, else the oldest
-    command still waiting.
+    command still waiting. A command sent with CmdType policy 0 (no reply wanted) never waits.
     """
 
     def __init__(self, tx_id: int = HOST_TX_ID, rx_id: int = HOST_RX_ID) -> None:
@@ -78,11 +78,13 @@ class LogDecoder:
         else:
             self.foreign_frames += 1
             return []
-        return self.feed_bytes(bytes(frame.data), direction, frame.timestamp)
+        items = self._framers[direction].feed_frame(bytes(frame.data))
+        return [self._record(item, direction, frame.timestamp) for item in items]
 
     def feed_bytes(self, data: bytes, direction: str | None = None,
                    timestamp: float | None = None) -> list[Record]:
-        """Raw stream bytes; ``direction`` None infers it per packet (see ``infer_direction``)."""
+        """Raw stream bytes; ``direction`` None infers it per packet (see ``infer_direction``).
+        Feed a direction either frames or bytes, not both."""
         if direction not in (*DIRECTIONS, None):
             raise ValueError(f"direction must be one of {DIRECTIONS} or None, not {direction!r}")
         return [self._record(item, direction, timestamp) for item in self._framers[direction].feed(data)]
@@ -128,7 +130,8 @@ class LogDecoder:
         code = getattr(message, "return_code", None)
         if code is not None:
             record["return_code_meaning"] = describe_return_code(code)
-        if direction == HOST_TO_GIMBAL and message.KIND is Kind.COMMAND and message.REPLY is not None:
+        if direction == HOST_TO_GIMBAL and message.KIND is Kind.COMMAND and message.REPLY is not None \
+                and packet.reply_policy != NO_REPLY:
             self._outstanding.append(_Outstanding(packet.seq, message, timestamp))
         record["hex"] = _hex(packet)
         return record

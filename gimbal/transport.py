@@ -5,6 +5,7 @@ import threading
 import time
 import weakref
 from collections import deque
+from typing import Any
 
 import can
 
@@ -14,6 +15,7 @@ from gimbal.packet import Packet, encode_packet
 HOST_TX_ID = 0x223  # the host sends here; the gimbal listens here
 HOST_RX_ID = 0x222  # the gimbal answers here
 CAN_FRAME_DATA = 8
+DEFAULT_BITRATE = 1_000_000  # the document's 波特率 1M (Figures 37 and 38)
 
 _BUS_LOCKS: weakref.WeakKeyDictionary[can.BusABC, threading.Lock] = weakref.WeakKeyDictionary()
 _BUS_LOCKS_GUARD = threading.Lock()
@@ -27,6 +29,19 @@ def bus_send_lock(bus: can.BusABC) -> threading.Lock:
         if lock is None:
             lock = _BUS_LOCKS[bus] = threading.Lock()
         return lock
+
+
+def with_default_bitrate(options: dict[str, Any]) -> dict[str, Any]:
+    """``can.Bus`` keyword arguments with ``bitrate=DEFAULT_BITRATE`` added when neither
+    ``options`` nor python-can's configuration (``can.util.load_config``: can.rc, ``CAN_BITRATE``,
+    ``CAN_CONFIG``, config files) gives a bitrate or bit timing. Interfaces whose bitrate is set
+    outside python-can (socketcan: ``ip link``; virtual, udp_multicast) ignore it. Raises what
+    ``load_config`` raises (``can.CanInterfaceNotImplementedError`` for an unknown interface)."""
+    config = options if options.get("ignore_config") else \
+        can.util.load_config(config=dict(options), context=options.get("config_context"))
+    if config.get("bitrate") is not None or config.get("timing") is not None:
+        return dict(options)
+    return {**options, "bitrate": DEFAULT_BITRATE}
 
 
 def packet_frames(raw: bytes, arbitration_id: int) -> list[can.Message]:
@@ -84,4 +99,4 @@ class CanTransport:
                 or frame.is_remote_frame:
             self.foreign_frames += 1
             return
-        self._ready.extend(self.framer.feed(bytes(frame.data)))
+        self._ready.extend(self.framer.feed_frame(bytes(frame.data)))

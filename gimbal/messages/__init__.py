@@ -31,6 +31,16 @@ def is_legacy_reply(packet: Packet) -> bool:
     return packet.is_reply and (not packet.data or packet.data[0] not in CMD_SETS)
 
 
+def reply_key(packet: Packet) -> tuple[int, int] | None:
+    """The CmdSet/CmdID a latest-layout reply repeats, None for a legacy reply. Raises
+    ``PayloadError`` for a latest-layout reply too short to hold both."""
+    if is_legacy_reply(packet):
+        return None
+    if len(packet.data) < 2:
+        raise PayloadError(f"reply data {packet.data.hex(' ')} is too short for CmdSet/CmdID")
+    return packet.data[0], packet.data[1]
+
+
 def is_device_push(packet: Packet) -> bool:
     """Whether CmdSet/CmdID name a push the device sends, whatever the reply bit says (some
     firmware sets it on pushes)."""
@@ -59,14 +69,13 @@ def decode_message(packet: Packet, request: type[Message] | Message | None = Non
 
 
 def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Message:
-    if is_legacy_reply(packet):
-        if request is None:
-            raise UnknownMessageError("legacy-layout reply (no CmdSet/CmdID) without the command it answers")
-        key, payload = (request.CMD_SET, request.CMD_ID), packet.data
-    elif len(packet.data) < 2:
-        raise PayloadError(f"reply data {packet.data.hex(' ')} is too short for CmdSet/CmdID")
+    key = reply_key(packet)
+    if key is not None:
+        payload = packet.data[2:]
+    elif request is None:
+        raise UnknownMessageError("legacy-layout reply (no CmdSet/CmdID) without the command it answers")
     else:
-        key, payload = (packet.data[0], packet.data[1]), packet.data[2:]
+        key, payload = (request.CMD_SET, request.CMD_ID), packet.data
     expected = getattr(request, "REPLY", None)
     if expected is not None and (expected.CMD_SET, expected.CMD_ID) == key:
         return expected.decode_payload(payload)
@@ -89,4 +98,5 @@ def message_packet(message: Message, seq: int, cmd_type: int | None = None,
 
 __all__ = ["CAMERA_CMD_SET", "GIMBAL_CMD_SET", "Command", "DevicePush", "HostPush", "Kind", "Message",
            "PayloadError", "Reply", "ReturnCodeReply", "Sender", "Tlv", "UnknownMessageError",
-           "all_message_classes", "decode_message", "is_device_push", "is_legacy_reply", "message_packet"]
+           "all_message_classes", "decode_message", "is_device_push", "is_legacy_reply", "message_packet",
+           "reply_key"]

@@ -78,7 +78,14 @@ class ParameterPush(DevicePush):
 
     @property
     def angles_valid(self) -> bool:
-        return bool(self.ctrl_byte & FLAG_ANGLES_VALID) and self.pitch_joint_angle is not None
+        """The flag says the angles are valid and the attitude is present (a short push may end
+        there, before the joint angles: see ``joint_valid``)."""
+        return bool(self.ctrl_byte & FLAG_ANGLES_VALID) and self.pitch_angle is not None
+
+    @property
+    def joint_valid(self) -> bool:
+        """``angles_valid`` and the joint angles are present too."""
+        return self.angles_valid and self.pitch_joint_angle is not None
 
     @property
     def limits_valid(self) -> bool:

@@ -9,6 +9,7 @@ from typing import Any
 import can
 
 from gimbal.sim import SimConfig, SimulatedGimbal, start_in_process
+from gimbal.transport import with_default_bitrate
 from pipelines.cli.common import CliError
 
 SIM_INTERFACE = "sim"
@@ -18,7 +19,8 @@ NO_INTERFACE = ("no CAN interface configured: pass -i/--interface (socketcan, sl
 
 def bus_options(args: argparse.Namespace) -> dict[str, Any]:
     """``can.Bus`` keyword arguments from -i/-c/-b; unset ones are left out so that can.rc,
-    ``CAN_*`` variables and ``~/.canrc`` fill them in."""
+    ``CAN_*`` variables and ``~/.canrc`` fill them in (``open_can_bus`` adds the 1 Mbit/s default
+    when none of them gives a bitrate)."""
     given = {"interface": args.interface, "channel": args.channel, "bitrate": args.bitrate}
     return {key: value for key, value in given.items() if value is not None}
 
@@ -39,7 +41,8 @@ def open_host_bus(args: argparse.Namespace) -> Iterator[can.BusABC]:
 
 
 def open_can_bus(options: dict[str, Any]) -> can.BusABC:
-    """``can.Bus(**options)``; failures become one-line ``CliError``s."""
+    """``can.Bus(**options)``, at 1 Mbit/s unless a bitrate is given or configured; failures
+    become one-line ``CliError``s."""
     try:
         config = can.util.load_config(config=dict(options))
     except can.CanInterfaceNotImplementedError as exc:
@@ -48,7 +51,7 @@ def open_can_bus(options: dict[str, Any]) -> can.BusABC:
         raise CliError(f"cannot open the CAN bus: unknown CAN interface: {_one_line(exc)}") from None
     where = f"{config['interface']} channel {config.get('channel')}"
     try:
-        return can.Bus(**options)
+        return can.Bus(**with_default_bitrate(options))
     except (can.CanError, OSError, ValueError, ImportError) as exc:
         raise CliError(f"cannot open the CAN bus ({where}): {_one_line(exc)}") from None
 

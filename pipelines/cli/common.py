@@ -84,7 +84,8 @@ def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | No
     group.add_argument("-c", "--channel", help="channel, e.g. can0, /dev/ttyACM0, PCAN_USBBUS1, a multicast "
                        "group (not with the simulated gimbal)")
     group.add_argument("-b", "--bitrate", type=parse_bitrate,
-                       help="bitrate in bit/s (DJI RS gimbals use 1000000; not with the simulated gimbal)")
+                       help="bitrate in bit/s (default: python-can's configuration, else 1000000, the DJI R SDK's "
+                       "1 Mbit/s; socketcan's is set with 'ip link'; not with the simulated gimbal)")
     group.add_argument("--tx-id", type=parse_can_id, default=0x223, help="CAN id the host sends on (default 0x223)")
     group.add_argument("--rx-id", type=parse_can_id, default=0x222, help="CAN id the host listens on (default 0x222)")
     if repeated:

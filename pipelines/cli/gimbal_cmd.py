@@ -15,8 +15,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, FIRST_SEQ,
-                           GimbalClient, lookup, position_message, speed_message)
+from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, MAX_TIMEOUT, ORIENTATIONS,
+                           FIRST_SEQ, GimbalClient, lookup, position_message, speed_message)
 from gimbal.errors import GimbalError, GimbalTimeoutError, RangeError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.messages import Message, message_packet
@@ -104,6 +104,7 @@ def describe_push(message: Message, t: float) -> Result:
     if isinstance(message, ParameterPush):
         if message.angles_valid:
             out["attitude"] = {a: _deg(getattr(message, f"{a}_angle")) for a in AXES}
+        if message.joint_valid:
             out["joint"] = {a: _deg(getattr(message, f"{a}_joint_angle")) for a in AXES}
         if message.limits_valid:
             out["limits"] = {n: getattr(message, n) for n in LIMITS}
@@ -255,11 +256,11 @@ def _watch_args(p: argparse.ArgumentParser) -> None:
 
 def _watch(client: GimbalClient, args: argparse.Namespace) -> Result:
     arrived: queue.Queue[tuple[Message, float]] = queue.Queue()
+    start = time.monotonic()  # before subscribing: a push may arrive before set_push returns
     for cls in (ParameterPush, CalibrationStatusPush):
         client.on_push(cls, lambda message, t: arrived.put((message, t)))
     if not args.no_enable:
         client.set_push(True)
-    start = time.monotonic()
     end = None if args.duration is None else start + args.duration
     try:
         while end is None or time.monotonic() < end:
@@ -495,13 +496,16 @@ def run(command: Command, args: argparse.Namespace) -> int:
         for message in messages:
             message.validate()
         if args.print_packet:
+            if not 0 <= args.seq <= 0xFFFF:
+                raise CliError(f"--seq must be 0..0xFFFF (SEQ is 2 bytes), not {args.seq:#x}")
             for offset, message in enumerate(messages):
                 packet = message_packet(message, (args.seq + offset) & 0xFFFF,
                                         command.cmd_types.get(type(message)))
                 print(" ".join(f"{b:02X}" for b in encode_packet(packet)))
             return 0
-        if not args.timeout > 0:
-            raise CliError("--timeout must be > 0")
+        if not 0 < args.timeout <= MAX_TIMEOUT:
+            raise CliError(f"--timeout must be a number of seconds above 0 (at most {MAX_TIMEOUT:.0f}), "
+                           f"not {args.timeout:g}")
         with open_host_bus(args) as bus, \
                 GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id, timeout=args.timeout) as client:
             result = command.run(client, args)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from operator import attrgetter
 from typing import TYPE_CHECKING
 
-from gimbal.messages.telemetry import FLAG_ANGLES_VALID, ParameterPush
+from gimbal.messages.telemetry import ParameterPush
 from pipelines.control.direction import wrap_deg
 
 if TYPE_CHECKING:
@@ -60,7 +60,7 @@ class AttitudeHistory:
         Skips pushes whose angle-valid flag is clear or that stop short of the attitude (short
         pushes carrying the attitude but not the joint angles are used).
         """
-        if not msg.ctrl_byte & FLAG_ANGLES_VALID or msg.pitch_angle is None:
+        if not msg.angles_valid:
             return
         self.add_raw(t, msg.yaw_angle, msg.roll_angle, msg.pitch_angle)
 

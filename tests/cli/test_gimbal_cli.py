@@ -12,9 +12,11 @@ from pathlib import Path
 import can
 import pytest
 
+from gimbal.messages import Message
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
-from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl
+from gimbal.messages.motion import AnglesReply, GetAngles, PositionControl, SpeedControl
 from gimbal.messages.settings import AngleLimitsReply, GetAngleLimits, SetAngleLimits
+from gimbal.messages.telemetry import ParameterPush, PushControl, PushControlReply
 from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv
 from pipelines.cli import main
 from tests.gimbal.scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages
@@ -47,6 +49,12 @@ def test_print_packet_for_a_query_uses_the_given_seq(capsys: pytest.CaptureFixtu
     (["focus", "position", "5000"], "position=5000 is outside 0..4095"),
     (["user-params", "--param-table", "3"], "param_table=3 is outside 0..2"),
     (["move"], "give at least one of --yaw, --roll, --pitch"),
+    (["angles", "--timeout", "inf"], "--timeout must be a number of seconds above 0"),
+    (["angles", "--timeout", "nan"], "--timeout must be a number of seconds above 0"),
+    (["angles", "--timeout=-1"], "--timeout must be a number of seconds above 0"),
+    (["angles", "--timeout", "1e12"], "--timeout must be a number of seconds above 0"),
+    (["angles", "--print-packet", "--seq", "0x12345"], "--seq must be 0..0xFFFF"),
+    (["angles", "--print-packet", "--seq=-1"], "--seq must be 0..0xFFFF"),
 ])
 def test_out_of_range_values_are_one_line_errors_before_anything_is_sent(
         channel: str, peer: ScriptedPeer, capsys: pytest.CaptureFixture[str], args: list[str],
@@ -144,6 +152,26 @@ def test_python_can_environment_configuration_is_used(
     assert json.loads(capsys.readouterr().out)["attitude"]["yaw"] == 1.0
 
 
+@pytest.mark.parametrize("args,bitrate", [([], 1_000_000), (["-b", "500000"], 500_000)])
+def test_the_bitrate_is_the_documents_1_mbit_unless_given(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+        args: list[str], bitrate: int) -> None:
+    monkeypatch.setattr(can, "rc", {})
+    monkeypatch.setenv("HOME", str(tmp_path))
+    for name in ("CAN_INTERFACE", "CAN_CHANNEL", "CAN_BITRATE", "CAN_CONFIG"):
+        monkeypatch.delenv(name, raising=False)
+    opened: list[dict[str, object]] = []
+
+    def fake_bus(**kwargs: object) -> can.BusABC:
+        opened.append(kwargs)
+        raise can.CanInitializationError("no adapter")
+
+    monkeypatch.setattr(can, "Bus", fake_bus)
+    assert main(["gimbal", "angles", "-i", "gs_usb", "-c", "0", *args]) == 2
+    assert opened == [{"interface": "gs_usb", "channel": "0", "bitrate": bitrate}]
+    assert "no adapter" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("args,words", [(["-i", "nosuchbus"], "unknown CAN interface"),
                                         (["-i", "socketcan", "-c", "nosuchcan0"], "cannot open")])
 def test_bus_open_failures_are_one_line_errors(capsys: pytest.CaptureFixture[str], args: list[str],
@@ -151,6 +179,40 @@ def test_bus_open_failures_are_one_line_errors(capsys: pytest.CaptureFixture[str
     assert main(["gimbal", "angles", *args]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and words in err
+
+
+def test_watch_shows_the_attitude_of_a_short_push_timed_from_its_start(
+        channel: str, peer: ScriptedPeer, capsys: pytest.CaptureFixture[str]) -> None:
+    def push_then_reply(message: Message) -> Message:
+        peer.push(ParameterPush(0x01, 32, 48, 64))  # 25 bytes: attitude only, before the reply
+        return PushControlReply()
+
+    peer.answer(PushControl, push_then_reply)
+    assert gimbal(channel, "watch", "--duration", "0.3", "--json") == 0
+    first = json.loads(capsys.readouterr().out.splitlines()[0])
+    assert first["push"] == "parameter_push" and first["t"] >= 0
+    assert first["attitude"] == {"yaw": 3.2, "roll": 4.8, "pitch": 6.4} and "joint" not in first
+
+
+def test_the_range_error_in_the_docs_is_what_the_cli_prints(capsys: pytest.CaptureFixture[str]) -> None:
+    doc = (Path(__file__).parents[2] / "docs" / "gimbal-cli.md").read_text(encoding="utf-8")
+    command = "$ gimbaltrack gimbal move --yaw 200 --print-packet\n"
+    shown = doc.split(command, 1)[1].splitlines()[0]
+    assert main(command.split()[2:]) == 2
+    assert capsys.readouterr().err.strip() == shown
+
+
+def test_the_python_example_in_the_docs_runs(channel: str, peer: ScriptedPeer,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    doc = (Path(__file__).parents[2] / "docs" / "gimbal-cli.md").read_text(encoding="utf-8")
+    example = doc.split("```python\n", 1)[1].split("```", 1)[0]
+    real_bus = 'GimbalClient(interface="socketcan", channel="can0")'
+    assert real_bus in example
+    peer.answer(GetAngles, AnglesReply(0, 1, 10, 20, 30))
+    peer.answer(PositionControl)
+    peer.answer(SpeedControl)
+    exec(example.replace(real_bus, f'GimbalClient(interface="virtual", channel="{channel}")'), {})
+    assert "Angles(kind='attitude', yaw=1.0, roll=2.0, pitch=3.0)" in capsys.readouterr().out
 
 
 @pytest.mark.skipif(importlib.util.find_spec("gimbal.sim") is None, reason="gimbal.sim not built yet")

@@ -54,7 +54,7 @@ from gimbal.messages.tlv_params import (
     UserParamsReply,
     motors_off,
 )
-from gimbal.packet import encode_packet
+from gimbal.packet import REPLY_CMD_TYPE, Packet, encode_packet
 from gimbal.signals import deferred_signals, exit_on_signals
 from tests.gimbal.scripted_peer import (
     RELEASE,
@@ -249,6 +249,16 @@ def test_late_replies_are_dropped_as_stale(client: GimbalClient, peer: ScriptedP
     assert client.stats["stale_replies"] == 1
 
 
+@pytest.mark.parametrize("data", [b"\x0e", b"\x0d"], ids=["0x0E", "0x0D"])
+def test_a_reply_too_short_for_cmdset_and_cmdid_is_counted_and_dropped(
+        client: GimbalClient, peer: ScriptedPeer, data: bytes) -> None:
+    peer.transport.send(Packet(cmd_type=REPLY_CMD_TYPE, seq=0x0007, data=data))
+    poll(lambda: client.stats["bad_replies"] == 1)
+    assert client.alive
+    peer.answer(GetAngleLimits, AngleLimitsReply(0, 1, 2, 3, 4, 5, 6))
+    assert client.get_angle_limits().pitch_max == 1
+
+
 def test_concurrent_requests_get_their_own_replies(client: GimbalClient, peer: ScriptedPeer) -> None:
     peer.answer(GetAngles, lambda m: AnglesReply(0, m.ctrl_byte, m.ctrl_byte * 100, 0, 0))
     results: dict[str, Angles] = {}
@@ -400,6 +410,14 @@ def test_only_buses_the_client_built_are_shut_down(channel: str, peer: ScriptedP
         pass
     given.send(can.Message(arbitration_id=1))  # still open
     given.shutdown()
+
+
+@pytest.mark.parametrize("timeout", [0.0, -1.0, float("nan"), float("inf")])
+def test_a_timeout_that_cannot_be_waited_for_is_refused(channel: str, timeout: float) -> None:
+    bus = can.Bus(interface="virtual", channel=channel)
+    with pytest.raises(ValueError, match="timeout must be above 0"):
+        GimbalClient(bus, timeout=timeout)
+    bus.shutdown()
 
 
 def test_an_unconfigured_bus_is_a_bus_error(monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:

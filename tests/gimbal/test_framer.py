@@ -87,6 +87,25 @@ def test_truncated_packet_then_packets_in_any_chunking(cut: int, size: int) -> N
     assert b"".join(data for _, data in drops(items)) == PUSH[:cut]
 
 
+def test_a_lost_last_frame_does_not_cost_the_next_packet() -> None:
+    # 25 bytes = frames of 8, 8, 8, 1, the last one holding only the final CRC byte 0xAA. When it is
+    # lost, the next packet's SOF completes this one with a valid CRC32: the next packet must
+    # still be found, since packets start at a frame's first byte.
+    lost_tail = next(raw for seq in range(0x10000) if (raw := encode_packet(
+        Packet(cmd_type=0x20, seq=seq, data=bytes.fromhex("0e 04 00 91 37 b3 b3 1e 1e"))))[-1] == 0xAA)
+    frames = [lost_tail[i:i + 8] for i in range(0, 24, 8)] + [REPLY[i:i + 8] for i in range(0, len(REPLY), 8)]
+    framer = PacketFramer()
+    items = [item for frame in frames for item in framer.feed_frame(frame)] + framer.flush()
+    assert items == [decode_packet(lost_tail), decode_packet(REPLY)]
+
+
+def test_frames_cut_across_packets_frame_like_the_stream() -> None:
+    # A sender that does not start each packet on a new frame: no harm done.
+    framer = PacketFramer()
+    items = [item for i in range(0, len(STREAM), 8) for item in framer.feed_frame(STREAM[i:i + 8])]
+    assert items + framer.flush() == PACKETS
+
+
 def test_truncated_at_end_of_stream() -> None:
     framer = PacketFramer()
     assert packets(framer.feed(DOC_EXAMPLE + SPEED[:20])) == PACKETS[:1]

@@ -74,6 +74,16 @@ def test_legacy_reply_with_fixed_seq_falls_back_to_command_order() -> None:
     assert [r.get("name") for r in decode_frames(frames)][2:] == ["get_angles_reply", "speed_control_reply"]
 
 
+def test_a_command_sent_with_cmd_type_0_waits_for_no_reply() -> None:
+    # CmdType 0x00: no reply wanted, so the legacy reply with the same (fixed) SEQ is get-angles'.
+    frames = [*frames_of(SpeedControl(), 1, 0x223, 1.0, cmd_type=0x00),
+              *frames_of(GetAngles(1), 1, 0x223, 1.001),
+              *frames_of(AnglesReply(0, 1, 32, 48, 64), 1, 0x222, 1.002, legacy=True)]
+    reply = list(decode_frames(frames))[2]
+    assert reply["name"] == "get_angles_reply" and reply["request_seq"] == 1
+    assert (reply["fields"]["yaw"], reply["fields"]["roll"], reply["fields"]["pitch"]) == (32, 48, 64)
+
+
 def test_legacy_reply_with_unechoed_seq_takes_oldest_command() -> None:
     frames = [*frames_of(GetAngles(1), 40, 0x223, 1.0),
               *frames_of(AnglesReply(0, 1, 1, 2, 3), 0, 0x222, 1.002, legacy=True)]
@@ -94,6 +104,16 @@ def test_a_reply_answers_one_command_only() -> None:
               *frames_of(SpeedControlReply(0), 1, 0x222, 1.001, legacy=True),
               *frames_of(SpeedControlReply(0), 1, 0x222, 1.002, legacy=True)]
     assert [r.get("error") for r in decode_frames(frames)] == [None, None, "unmatched_legacy_reply"]
+
+
+def test_a_lost_last_frame_does_not_cost_the_next_packet() -> None:
+    # The first packet's 1-byte last frame (0xAA) is lost: the next packet's SOF completes it.
+    first = next(raw for seq in range(0x10000) if (raw := encode_packet(
+        Packet(cmd_type=0x20, seq=seq, data=bytes.fromhex("0e 04 00 91 37 b3 b3 1e 1e"))))[-1] == 0xAA)
+    frames = packet_frames(first, 0x222)[:-1] + frames_of(AnglesReply(0, 1, 32, 48, 64), 7, 0x222, 1.0)
+    records = list(decode_frames(frames))
+    assert [(r.get("name"), r.get("error")) for r in records] == \
+        [("get_angle_limits_reply", None), ("get_angles_reply", None)]
 
 
 def test_pushes_with_reply_bit_do_not_consume_commands() -> None:

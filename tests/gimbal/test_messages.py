@@ -307,7 +307,8 @@ def test_short_25_byte_push_reports_missing_fields_as_none() -> None:
     push = decode_message(decode_packet(raw))
     assert (push.ctrl_byte, push.yaw_angle, push.roll_angle, push.pitch_angle) == (7, 100, -20, 300)
     assert push.yaw_joint_angle is None and push.roll_stiffness is None
-    assert not push.angles_valid and not push.limits_valid and not push.stiffness_valid
+    assert push.angles_valid  # flag bit 0 set and the attitude is there
+    assert not push.joint_valid and not push.limits_valid and not push.stiffness_valid
 
 
 def test_push_flags_byte_is_not_a_return_code() -> None:

@@ -2,19 +2,23 @@
 from __future__ import annotations
 
 import itertools
+import json
 import threading
 import time
 from collections.abc import Iterator
+from pathlib import Path
 
 import can
 import pytest
 
+from gimbal.client import GimbalClient
+from gimbal.errors import BusError
 from gimbal.framer import Dropped
 from gimbal.messages import message_packet
 from gimbal.messages.motion import AnglesReply, SpeedControl
 from gimbal.messages.telemetry import ParameterPush
 from gimbal.packet import Packet, decode_packet, encode_packet
-from gimbal.transport import CanTransport, packet_frames
+from gimbal.transport import CanTransport, packet_frames, with_default_bitrate
 
 _channels = itertools.count()
 
@@ -162,3 +166,64 @@ def test_corrupted_frames_surface_as_drops(channel: str) -> None:
         bus.shutdown()
         sender.shutdown()
 
+
+def test_a_packet_after_a_lost_last_frame_is_kept(channel: str) -> None:
+    # A's last frame holds only its final CRC byte, 0xAA; lost, B's SOF completes A. B must survive.
+    a = next(raw for seq in range(0x10000) if (raw := encode_packet(
+        Packet(cmd_type=0x20, seq=seq, data=bytes.fromhex("0e 04 00 91 37 b3 b3 1e 1e"))))[-1] == 0xAA)
+    b = encode_packet(message_packet(AnglesReply(0, 1, 32, 48, 64), 7))
+    bus = can.Bus(interface="virtual", channel=channel)
+    try:
+        transport = CanTransport(bus)
+        for frame in packet_frames(a, 0x222)[:-1] + packet_frames(b, 0x222):
+            transport.feed_frame(frame)
+        assert [transport.recv(0), transport.recv(0), transport.recv(0)] == \
+            [decode_packet(a), decode_packet(b), None]
+    finally:
+        bus.shutdown()
+
+
+@pytest.fixture
+def no_can_config(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> pytest.MonkeyPatch:
+    """python-can with no configuration anywhere: no can.rc, no CAN_* variables, no ~/.canrc."""
+    monkeypatch.setattr(can, "rc", {})
+    monkeypatch.setenv("HOME", str(tmp_path))
+    for name in ("CAN_INTERFACE", "CAN_CHANNEL", "CAN_BITRATE", "CAN_CONFIG"):
+        monkeypatch.delenv(name, raising=False)
+    return monkeypatch
+
+
+@pytest.mark.parametrize("interface", ["gs_usb", "pcan", "slcan", "kvaser", "socketcan", "virtual"])
+def test_the_bitrate_defaults_to_the_documents_1_mbit(no_can_config: pytest.MonkeyPatch,
+                                                      interface: str) -> None:
+    assert with_default_bitrate({"interface": interface}) == {"interface": interface,
+                                                              "bitrate": 1_000_000}
+
+
+@pytest.mark.parametrize("where", ["option", "can.rc", "CAN_BITRATE", "CAN_CONFIG timing"])
+def test_a_given_or_configured_bitrate_is_left_alone(no_can_config: pytest.MonkeyPatch,
+                                                     where: str) -> None:
+    options: dict[str, object] = {"interface": "pcan"}
+    if where == "option":
+        options["bitrate"] = 500_000
+    elif where == "can.rc":
+        no_can_config.setattr(can, "rc", {"bitrate": 250_000})
+    elif where == "CAN_BITRATE":
+        no_can_config.setenv("CAN_BITRATE", "125000")
+    else:
+        no_can_config.setenv("CAN_CONFIG", json.dumps({"f_clock": 8_000_000, "brp": 1, "tseg1": 5,
+                                                       "tseg2": 2, "sjw": 1, "nof_samples": 1}))
+    assert with_default_bitrate(options) == options
+
+
+def test_a_bus_built_by_the_client_gets_the_default_bitrate(no_can_config: pytest.MonkeyPatch) -> None:
+    opened: list[dict[str, object]] = []
+
+    def fake_bus(**kwargs: object) -> can.BusABC:
+        opened.append(kwargs)
+        raise can.CanInitializationError("no adapter")
+
+    no_can_config.setattr(can, "Bus", fake_bus)
+    with pytest.raises(BusError, match="no adapter"):
+        GimbalClient(interface="gs_usb", channel="0")
+    assert opened == [{"interface": "gs_usb", "channel": "0", "bitrate": 1_000_000}]
