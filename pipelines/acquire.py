@@ -67,7 +67,7 @@ def parse_roi(text: str) -> tuple[int, int, int, int]:
     parts = text.replace(" ", "").split(",")
     try:
         x, y, w, h = (int(float(p)) for p in parts)
-    except ValueError:
+    except (ValueError, OverflowError):  # OverflowError: inf (or 1e400) has no integer
         raise ValueError(f"--roi takes x,y,w,h in pixels, not {text!r}") from None
     if w <= 0 or h <= 0:
         raise ValueError(f"--roi {text!r}: w and h must be > 0")

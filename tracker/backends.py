@@ -8,9 +8,9 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from tracker.boxes import Box
+from tracker.boxes import Box, cut_to_frame
 from tracker.dcf import DcfBackend
-from tracker.nanotrack import NanoTrackBackend, nanotrack_model_files
+from tracker.nanotrack import NanoTrackBackend, load_nanotrack_networks, nanotrack_model_files
 
 
 class TrackingBackend(Protocol):
@@ -37,7 +37,8 @@ class OpenCvBackend:
 
     def init(self, frame: np.ndarray, box: Box) -> None:
         self._tracker = self._create()
-        self._tracker.init(frame, _int_box(box))
+        height, width = frame.shape[:2]
+        self._tracker.init(frame, _int_box(cut_to_frame(box, width, height)))  # some crash on a box over an edge
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
         if self._tracker is None:
@@ -71,6 +72,7 @@ FAST_CSRT = {"use_segmentation": False}
 
 
 def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
+    load_nanotrack_networks(model_dir)  # wrong or damaged files fail here, naming the file, not in init()
     backbone, head = nanotrack_model_files(model_dir)
 
     def create() -> cv2.Tracker:

@@ -19,6 +19,10 @@ FRAME_DIRS = ("img", "imgs", "color")
 ASSUMED_FPS = 30.0
 
 
+class FrameReadError(ValueError):
+    """A frame of a sequence cannot be read: a damaged image, or a video that ends early."""
+
+
 @dataclass(frozen=True)
 class Sequence:
     """Frames (image files or one video) and, when known, one ground-truth box per frame."""
@@ -36,37 +40,46 @@ class Sequence:
         return len(self.frame_paths)
 
     def frames(self) -> Iterator[np.ndarray]:
-        """The BGR frames in order (as many as there are ground-truth boxes, when known)."""
-        limit = len(self)
+        """The BGR frames in order; ``FrameReadError`` names the sequence and the frame that fails."""
         if self.video_path is not None:
-            yield from _read_video(self.video_path, limit)
+            yield from _read_video(self.name, self.video_path, len(self))
             return
-        for path in self.frame_paths[:limit]:
+        for number, path in enumerate(self.frame_paths[:len(self)], start=1):
             image = cv2.imread(str(path), cv2.IMREAD_COLOR)
             if image is None:
-                raise ValueError(f"cannot read image {path}")
+                raise FrameReadError(f"{self.name}: cannot read frame {number} ({path})")
             yield image
 
 
 def parse_groundtruth(path: Path) -> tuple[Box, ...]:
-    """Boxes from an OTB ``x,y,w,h`` or VOT 8-value polygon file (comma, tab or space separated)."""
-    boxes: list[Box] = []
-    for number, line in enumerate(Path(path).read_text().splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            values = [float(v) for v in re.split(r"[,\s]+", line.strip())]
-        except ValueError:
-            raise ValueError(f"{path}:{number}: not numbers: {line.strip()!r}") from None
-        if len(values) == 4:
-            boxes.append((values[0], values[1], values[2], values[3]))
-        elif len(values) == 8:
-            boxes.append(polygon_to_box(values))
-        else:
-            raise ValueError(f"{path}:{number}: expected 4 (x,y,w,h) or 8 (polygon) values, got {len(values)}")
-    if not boxes:
+    """Boxes from an OTB ``x,y,w,h`` or VOT 8-value polygon file (comma, tab or space separated).
+
+    Line n is frame n's box (``NaN`` or zero values where the subject is not visible, as UAV123, OTB
+    and VOT write them). A UTF-8 byte-order mark and blank lines at the end are ignored; a blank line
+    before the last box is an error, since skipping it would pair every later box with the wrong frame.
+    """
+    lines = Path(path).read_text(encoding="utf-8-sig").splitlines()
+    while lines and not lines[-1].strip():
+        lines.pop()
+    if not lines:
         raise ValueError(f"{path}: no ground-truth boxes")
-    return tuple(boxes)
+    return tuple(_parse_box(path, number, line.strip()) for number, line in enumerate(lines, start=1))
+
+
+def _parse_box(path: Path, number: int, text: str) -> Box:
+    """Line ``number`` of ``path``: 4 values (x,y,w,h) or 8 (a polygon, turned into its min/max box)."""
+    if not text:
+        raise ValueError(f"{path}:{number}: blank line (each line is one frame's box; NaN,NaN,NaN,NaN "
+                         "marks a frame without the subject)")
+    try:
+        values = [float(v) for v in re.split(r"[,\s]+", text)]
+    except ValueError:
+        raise ValueError(f"{path}:{number}: not numbers: {text!r}") from None
+    if len(values) == 4:
+        return values[0], values[1], values[2], values[3]
+    if len(values) == 8:
+        return polygon_to_box(values)
+    raise ValueError(f"{path}:{number}: expected 4 (x,y,w,h) or 8 (polygon) values, got {len(values)}")
 
 
 def load_sequence(path: str | Path, groundtruth: str | Path | None = None) -> Sequence:
@@ -85,15 +98,26 @@ def load_sequence(path: str | Path, groundtruth: str | Path | None = None) -> Se
         gt_path = Path(groundtruth) if groundtruth else _find_groundtruth(path.parent, path.stem + ".txt",
                                                                             path.stem + "_groundtruth.txt")
         truth = parse_groundtruth(gt_path) if gt_path else None
-        if truth is not None and len(truth) > _video_frame_count(path):
-            raise ValueError(f"{gt_path} has {len(truth)} boxes but {path} has fewer frames")
+        if truth is not None:
+            _check_box_count(gt_path, len(truth), path, _video_frame_count(path))
         return Sequence(path.stem, video_path=path, groundtruth=truth)
     frames = _find_frames(path)
     gt_path = Path(groundtruth) if groundtruth else _find_groundtruth(path)
     truth = parse_groundtruth(gt_path) if gt_path else None
-    if truth is not None and len(truth) > len(frames):
-        raise ValueError(f"{gt_path} has {len(truth)} boxes but {path} has only {len(frames)} frames")
+    if truth is not None:
+        _check_box_count(gt_path, len(truth), path, len(frames))
     return Sequence(path.name, frame_paths=frames, groundtruth=truth)
+
+
+def _check_box_count(gt_path: Path, boxes: int, path: Path, frames: int) -> None:
+    """One box per frame, from the first: any other count would pair boxes with the wrong frames
+    (a video's count is its header's)."""
+    if boxes > frames:
+        raise ValueError(f"{gt_path} has {boxes} boxes but {path} has only {frames} frames")
+    if boxes < frames:
+        raise ValueError(f"{gt_path} has {boxes} boxes but {path} has {frames} frames: one box per frame is needed "
+                         "(an annotation that starts at a later frame, as some OTB-2015 sequences' do, needs the "
+                         "frames before it removed)")
 
 
 def _natural_key(path: Path) -> list[int | str]:
@@ -144,13 +168,15 @@ def _video_frame_count(path: Path) -> int:
         capture.release()
 
 
-def _read_video(path: Path, limit: int) -> Iterator[np.ndarray]:
+def _read_video(name: str, path: Path, count: int) -> Iterator[np.ndarray]:
+    """The first ``count`` frames of ``path``; ``FrameReadError`` when it ends (or breaks) before."""
     capture = _open_video(path)
     try:
-        for _ in range(limit):
+        for number in range(1, count + 1):
             ok, frame = capture.read()
             if not ok:
-                return
+                raise FrameReadError(f"{name}: cannot read frame {number} of the {count} in {path} "
+                                     "(truncated or damaged?)")
             yield frame
     finally:
         capture.release()

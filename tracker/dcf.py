@@ -111,12 +111,15 @@ class DcfBackend:
         return from_center(float(self._center[0]), float(self._center[1]), float(w), float(h)), score
 
     def _score(self, peak: float) -> float:
-        """The peak relative to its running typical value: 1 as usual, towards 0 as it collapses."""
+        """The peak relative to its running typical value: 1 as usual, towards 0 as it collapses.
+        Only frames confident enough to teach the models move the typical value, so it never
+        sinks to the background's level while the subject is gone (the score would climb back)."""
         if self._typical_peak <= 0.0:
             self._typical_peak = peak
         score = float(np.clip(peak / max(self._typical_peak, 1e-6), 0.0, 1.0))
-        rate = self.settings.peak_rate * score
-        self._typical_peak = (1 - rate) * self._typical_peak + rate * peak
+        if score >= self.settings.learn_above:
+            rate = self.settings.peak_rate * score
+            self._typical_peak = (1 - rate) * self._typical_peak + rate * peak
         return score
 
     def _rescale_and_learn(self, frame: np.ndarray, score: float) -> None:

@@ -70,7 +70,11 @@ class YuNetFaceDetector:
 
 
 class HogPersonDetector:
-    """OpenCV's HOG + linear SVM people detector (built in; finds people ~100 px tall and up)."""
+    """OpenCV's HOG + linear SVM people detector (built in; finds people ~100 px tall and up).
+
+    Frames smaller than its 64 x 128 px window (after shrinking to ``max_side``) give no detections:
+    OpenCV's detector corrupts memory on them.
+    """
 
     def __init__(self, max_side: int = 640) -> None:
         self._hog = cv2.HOGDescriptor()
@@ -78,12 +82,21 @@ class HogPersonDetector:
         self._max_side = max_side
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
+        if not self._fits_window(frame):
+            return []
         scale = min(1.0, self._max_side / max(frame.shape[:2]))
         image = cv2.resize(frame, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA) if scale < 1 else frame
+        if not self._fits_window(image):
+            return []
         boxes, weights = self._hog.detectMultiScale(image, winStride=(8, 8), padding=(8, 8), scale=1.05)
         found = [Detection(tuple(float(v) / scale for v in b), float(1.0 / (1.0 + np.exp(-float(w)))))
                  for b, w in zip(boxes, np.ravel(weights))]
         return sorted(found, key=lambda d: d.score, reverse=True)
+
+    def _fits_window(self, image: np.ndarray) -> bool:
+        """Whether ``image`` holds at least one detection window."""
+        window_w, window_h = self._hog.winSize
+        return image.shape[1] >= window_w and image.shape[0] >= window_h
 
 
 class MotionDetector:
@@ -128,11 +141,20 @@ def _closing_kernel(shape: tuple[int, ...]) -> np.ndarray:
 
 
 def make_detector(kind: str, model_dir: str | Path | None = None) -> Detector:
-    """A detector by kind: ``face`` (YuNet with ``model_dir``, else Haar), ``person`` or ``motion``."""
+    """A detector by kind: ``face`` (YuNet when ``model_dir`` holds its file, else Haar), ``person`` or ``motion``."""
     if kind == "face":
-        return YuNetFaceDetector(model_dir) if model_dir is not None else HaarFaceDetector()
+        return _face_detector(model_dir)
     if kind == "person":
         return HogPersonDetector()
     if kind == "motion":
         return MotionDetector()
     raise ValueError(f"unknown detector kind {kind!r} (known: {', '.join(DETECTOR_KINDS)})")
+
+
+def _face_detector(model_dir: str | Path | None) -> Detector:
+    """YuNet when ``model_dir`` holds ``face_detection_yunet*.onnx``, else the Haar cascade (a model
+    folder with NanoTrack's files only still gives face detection)."""
+    try:
+        return YuNetFaceDetector(model_dir)
+    except FileNotFoundError:
+        return HaarFaceDetector()

@@ -22,6 +22,7 @@ EXEMPLAR_SIZE = 127  # template crop side, pixels
 INSTANCE_SIZE = 255  # search crop side, pixels
 STRIDE = 16  # search-crop pixels per score-map cell
 SCORE_SIZE = 16  # score map side (the head only accepts a 16x16 search feature map)
+TEMPLATE_FEATURES = 8  # the backbone's feature map side for a template crop
 MIN_SIZE = 10.0  # smallest box side kept, pixels
 
 
@@ -51,6 +52,61 @@ def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
     backbone = find_model_file(model_dir, "nanotrack_v2", "nanotrack_backbone*.onnx", "NanoTrack")
     head = find_model_file(model_dir, "nanotrack_v2", "nanotrack_head*.onnx", "NanoTrack")
     return backbone, head
+
+
+def load_nanotrack_networks(model_dir: str | Path | None) -> tuple[cv2.dnn.Net, cv2.dnn.Net]:
+    """The backbone and neck/head networks from ``model_dir``, each checked by one run on blank crops.
+
+    A file that is no ONNX network, or not the network its name says (the two swapped, or the same
+    network twice), raises ``ValueError`` naming it, here rather than as an OpenCV error mid-run.
+    """
+    backbone_path, head_path = nanotrack_model_files(model_dir)
+    backbone = _read_network(backbone_path, "backbone")
+    template = _backbone_features(backbone, backbone_path, EXEMPLAR_SIZE, TEMPLATE_FEATURES)
+    search = _backbone_features(backbone, backbone_path, INSTANCE_SIZE, SCORE_SIZE)
+    head = _read_network(head_path, "neck/head")
+    _check_head(head, head_path, template, search)
+    return backbone, head
+
+
+def _read_network(path: Path, role: str) -> cv2.dnn.Net:
+    """The ONNX network in ``path``; ValueError naming the file when OpenCV cannot read it."""
+    try:
+        net = cv2.dnn.readNet(str(path))
+    except cv2.error:
+        net = None
+    if net is None or net.empty():
+        raise ValueError(f"NanoTrack {role} {path}: not a readable ONNX network (damaged or another file?)")
+    return net
+
+
+def _backbone_features(net: cv2.dnn.Net, path: Path, crop: int, side: int) -> np.ndarray:
+    """The backbone's features of a blank ``crop`` px crop; ValueError naming ``path`` unless they
+    are ``side`` x ``side`` maps, as NanoTrack's backbone gives."""
+    try:
+        net.setInput(np.zeros((1, 3, crop, crop), np.float32))
+        features = net.forward()
+    except cv2.error:
+        features = None
+    if features is None or features.ndim != 4 or features.shape[2:] != (side, side):
+        raise ValueError(f"NanoTrack backbone {path}: not NanoTrack's backbone (a {crop} px crop must give "
+                         f"{side}x{side} features; is it the neck/head file?)")
+    return features
+
+
+def _check_head(net: cv2.dnn.Net, path: Path, template: np.ndarray, search: np.ndarray) -> None:
+    """ValueError naming ``path`` unless the network takes the backbone's template and search features
+    (``input1``, ``input2``) and gives the score and box maps (``output1``, ``output2``)."""
+    try:
+        net.setInput(template, "input1")
+        net.setInput(search, "input2")
+        cls, loc = net.forward(["output1", "output2"])
+        shapes = (cls.shape, loc.shape)
+    except cv2.error:
+        shapes = None
+    if shapes != ((1, 2, SCORE_SIZE, SCORE_SIZE), (1, 4, SCORE_SIZE, SCORE_SIZE)):
+        raise ValueError(f"NanoTrack neck/head {path}: not NanoTrack's neck/head network (it must take the "
+                         "backbone's template and search features; is it a second backbone?)")
 
 
 def hanning_window(size: int) -> np.ndarray:
@@ -134,9 +190,7 @@ class NanoTrackBackend:
     def __init__(self, model_dir: str | Path | None, params: NanoTrackParams | None = None) -> None:
         self.name = "nanotrack"
         self.params = params or NanoTrackParams()
-        backbone, head = nanotrack_model_files(model_dir)
-        self._backbone = cv2.dnn.readNet(str(backbone))
-        self._head = cv2.dnn.readNet(str(head))
+        self._backbone, self._head = load_nanotrack_networks(model_dir)
         self._window = hanning_window(SCORE_SIZE)
         self._offsets = grid_offsets()
         self._center = np.zeros(2)

@@ -8,7 +8,7 @@ import numpy as np
 
 from tracker.appearance import AppearanceModel, Match, cut_patch
 from tracker.backends import TrackingBackend
-from tracker.boxes import Box, clip_to_frame
+from tracker.boxes import Box, start_box
 from tracker.detectors import Detector
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.kalman import BoxKalman
@@ -54,9 +54,10 @@ class SubjectTracker:
         self._frame_index = -1
 
     def init(self, frame: np.ndarray, box: Box, timestamp: float) -> TargetEstimate:
-        """Start following ``box`` (x, y, w, h) in ``frame``."""
+        """Start following ``box`` (x, y, w, h) in ``frame``; it may reach over the frame's edges
+        (``ValueError`` when it misses the frame)."""
         height, width = frame.shape[:2]
-        box = clip_to_frame(tuple(float(v) for v in box), width, height)
+        box = start_box(tuple(float(v) for v in box), width, height)
         self._appearance = AppearanceModel(frame, box)
         self._restart(frame, box, timestamp)
         self._frame_index = 0

@@ -3,14 +3,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from collections.abc import Callable
 
 import cv2
 
 from pipelines.cli.common import CliError, existing_dir
 from pipelines.progress import ProgressReporter
-from tracker.datasets import GROUNDTRUTH_NAMES, Sequence, load_sequence
-from tracker.evaluation import SequenceResult, run_sequence, summarize
+from tracker.datasets import GROUNDTRUTH_NAMES, FrameReadError, Sequence, load_sequence
+from tracker.evaluation import SequenceResult, Trackable, first_box, run_sequence, summarize
 from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers, make_tracker
 
 
@@ -18,10 +19,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "eval", help="score a tracker on sequences with ground truth (precision@20px, success AUC, fps)",
         description="OTB protocol: initialise on the first ground-truth box, never re-initialise; a lost "
-        "subject holds the last box. fps is of the tracking step alone, on one thread.",
+        "subject holds the last box. Frames whose ground truth is NaN or 0,0,0,0 (subject not visible) "
+        "are left out of both scores. fps is of the tracking step alone, on one thread (null in --json "
+        "when nothing was timed: a one-frame sequence).",
         epilog="examples:\n  gimbaltrack eval ../shared/data/sequences/otb_girl ../shared/data/sequences/vot15_ball1\n"
         "  gimbaltrack eval samples/demo.mp4 --tracker csrt --json\n"
-        "  gimbaltrack eval ../shared/data/sequences/otb_girl --tracker nanotrack --model-dir ../shared/data/models",
+        "  gimbaltrack eval ../shared/data/sequences/otb_girl --tracker nanotrack --model-dir ../shared/data/models\n\n"
+        "exit status: 0 done; 2 bad input. Every sequence is checked before the first runs; a frame that\n"
+        "  cannot be read (a damaged image, a truncated video) is found only on the way: that sequence\n"
+        "  is skipped with an error line, the others are scored and summarised, and the exit status is 2.",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("sequences", nargs="+", metavar="SEQ_DIR",
                         help="OTB/VOT sequence folder, image folder with groundtruth, or video with one beside it")
@@ -44,16 +50,29 @@ def run(args: argparse.Namespace) -> int:
             subject = make_tracker(args.tracker, args.model_dir)
         except (ValueError, FileNotFoundError) as exc:
             raise CliError(str(exc)) from None
-        reporter = ProgressReporter(len(sequence))
-        try:
-            result = run_sequence(subject, sequence, progress=_progress(reporter, sequence.name))
-        finally:  # also when interrupted, so that the note which follows starts on a line of its own
-            reporter.close()
-        results.append(result)
-        print(json.dumps(result.as_dict()) if args.json else _row(result), flush=True)
-    summary = {"tracker": subject.name, **summarize(results)}
-    print(json.dumps(summary) if args.json else _row_summary(summary))
-    return 0
+        result = _score(subject, sequence, skipped_note=len(sequences) > 1)
+        if result is not None:
+            results.append(result)
+            print(json.dumps(result.as_dict()) if args.json else _row(result), flush=True)
+    if results:
+        summary = {"tracker": subject.name, **summarize(results)}
+        print(json.dumps(summary) if args.json else _row_summary(summary))
+    return 0 if len(results) == len(sequences) else 2
+
+
+def _score(subject: Trackable, sequence: Sequence, skipped_note: bool) -> SequenceResult | None:
+    """``sequence``'s scores, or None after a one-line error on stderr when one of its frames cannot be
+    read (``skipped_note``: say that the summary leaves it out)."""
+    reporter = ProgressReporter(len(sequence))
+    try:
+        return run_sequence(subject, sequence, progress=_progress(reporter, sequence.name))
+    except FrameReadError as exc:
+        error = str(exc)
+    finally:  # also when interrupted, so that the note which follows starts on a line of its own
+        reporter.close()
+    note = " (skipped; the summary covers the other sequences)" if skipped_note else ""
+    print(f"gimbaltrack eval: error: {error}{note}", file=sys.stderr, flush=True)
+    return None
 
 
 def _load(path: str) -> Sequence:
@@ -68,6 +87,10 @@ def _load(path: str) -> Sequence:
             names += [f"{stem}.txt", f"{stem}_groundtruth.txt"]
         where = "beside the video" if sequence.video_path is not None else "in the folder"
         raise CliError(f"{path}: no ground truth ({', '.join(names[:-1])} or {names[-1]} {where})")
+    try:
+        first_box(sequence)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
     return sequence
 
 
@@ -82,9 +105,14 @@ def _progress(reporter: ProgressReporter, name: str) -> Callable[[int, int], Non
 # value read the same.
 def _row(r: SequenceResult) -> str:
     d = r.as_dict()
-    return f"{r.name:24s} frames {r.frames:5d}  prec20 {d['prec20']:.4f}  auc {d['auc']:.4f}  fps {d['fps']:7.1f}"
+    return f"{r.name:24s} frames {r.frames:5d}  prec20 {d['prec20']:.4f}  auc {d['auc']:.4f}  fps {_fps(d['fps'])}"
 
 
 def _row_summary(s: dict) -> str:
     return (f"{'overall (' + s['tracker'] + ')':24s} seqs {s['sequences']:6d}  prec20 {s['prec20']:.4f}  "
-            f"auc {s['auc']:.4f}  fps {s['fps']:7.1f} (median)")
+            f"auc {s['auc']:.4f}  fps {_fps(s['fps'])} (median)")
+
+
+def _fps(fps: float | None) -> str:
+    """A rate for the text rows; ``-`` where none was measured (a one-frame sequence)."""
+    return f"{'-':>7s}" if fps is None else f"{fps:7.1f}"

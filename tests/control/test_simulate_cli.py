@@ -12,6 +12,7 @@ import pytest
 import pipelines.cli
 from pipelines.cli import main
 from pipelines.control.camera import DEFAULT_HFOV_DEG
+from tests import fake_onnx
 from tests.support import ROOT, cli_command, signalled, subprocess_env, wait_until
 
 @pytest.fixture(autouse=True)
@@ -29,17 +30,25 @@ def simulate(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, 
 def test_summary_reports_the_tracker_and_field_of_view_used(sequence: Path, tmp_path: Path,
                                                             capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out"
-    code, stdout, _ = simulate([str(sequence), "--size", "320x180", "--fps", "60", "--json", "--out", str(out)],
+    code, stdout, _ = simulate([str(sequence), "--size", "480x270", "--fps", "60", "--json", "--out", str(out)],
                                capsys)
     assert code == 0
     summary = json.loads(stdout)
-    # crop-equivalent: the 640 px source's focal length (24 mm full frame) seen by a 320 px view
+    # crop-equivalent: the 640 px source's focal length (24 mm full frame) seen by a 480 px view
     source_focal = 320 / math.tan(math.radians(DEFAULT_HFOV_DEG) / 2)
     assert summary["tracker"] == "dcf"
-    assert summary["fov_deg"] == pytest.approx(math.degrees(2 * math.atan(160 / source_focal)))
+    assert summary["fov_deg"] == pytest.approx(math.degrees(2 * math.atan(240 / source_focal)))
     assert json.loads((out / "summary.json").read_text()) == summary
     code, stdout, _ = simulate([str(sequence), "--fps", "60", "--fov", "50", "--tracker", "oracle"], capsys)
     assert code == 0 and "tracker oracle, view 640x360 at 50.0 deg" in stdout
+
+
+def test_a_subject_starting_outside_the_view_is_a_one_line_error(sequence: Path,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """A 320 px crop of the 640 px source misses the subject's first box: nothing to start on
+    (the tracker used to start on the patch the box was moved to)."""
+    code, _, err = simulate([str(sequence), "--size", "320x180", "--fps", "60"], capsys)
+    assert code == 2 and "lies outside the 320x180 frame" in err and "Traceback" not in err
 
 
 def test_model_dir_reaches_the_tracker(sequence: Path, shared_data: Path,
@@ -69,6 +78,19 @@ def test_bad_options_fail_at_once_in_one_line(argv: list[str], message: str, seq
     assert code == 2 and stdout == ""
     assert err.startswith(f"gimbaltrack simulate: error: {message.format(file=file, empty=empty)}")
     assert err.count("\n") == 1
+
+
+@pytest.mark.parametrize("backbone, head, wrong", [
+    (b"junk!", fake_onnx.head_bytes(), "nanotrack_backbone_sim.onnx: not a readable ONNX network"),
+    (fake_onnx.head_bytes(), fake_onnx.backbone_bytes(), "nanotrack_backbone_sim.onnx: not NanoTrack's backbone"),
+    (fake_onnx.backbone_bytes(), fake_onnx.backbone_bytes(), "nanotrack_head_sim.onnx: not NanoTrack's neck/head"),
+])
+def test_wrong_model_files_are_named_in_one_line(backbone: bytes, head: bytes, wrong: str, sequence: Path,
+                                                 tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    models = fake_onnx.write_nanotrack_files(tmp_path / "models", backbone, head)  # once a cv2.error traceback
+    code, stdout, err = simulate([str(sequence), "--fps", "60", "--model-dir", str(models)], capsys)
+    assert code == 2 and stdout == ""
+    assert err.startswith("gimbaltrack simulate: error: NanoTrack") and wrong in err and err.count("\n") == 1
 
 
 def test_help_lists_trackers_defaults_and_examples(capsys: pytest.CaptureFixture[str]) -> None:

@@ -49,7 +49,8 @@ def test_pick_central_largest_and_near():
     assert pick_candidate([], SIZE) is None
 
 
-@pytest.mark.parametrize("text", ["1,2,3", "a,b,c,d", "0,0,0,10", "1,0,5,-5"])
+@pytest.mark.parametrize("text", ["1,2,3", "a,b,c,d", "0,0,0,10", "1,0,5,-5", "inf,0,10,10", "nan,0,10,10",
+                                  "1e400,0,10,10", "0,0,inf,10"])  # inf: once an OverflowError
 def test_parse_roi_refuses_bad_boxes(text):
     with pytest.raises(ValueError, match="--roi"):
         parse_roi(text)

@@ -14,6 +14,7 @@ import gimbal.sim
 import pipelines.cli.bus
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
+from tests import fake_onnx
 from tests.support import ROOT, cli_command, free_udp_port, subprocess_env, wait_until
 from tests.track.helpers import (
     DEMO,
@@ -39,6 +40,7 @@ def _one_line_error(capsys: pytest.CaptureFixture[str], *words: str) -> str:
 
 @pytest.mark.parametrize("args, words", [
     (["--roi", "1,2,x,4"], ["--roi"]),
+    (["--roi", "inf,0,10,10"], ["--roi", "x,y,w,h"]),  # once an OverflowError traceback
     (["--roi", "10,10,0,5"], ["w and h"]),
     (["--tracker", "no-such-tracker"], ["no-such-tracker"]),
     (["--max-speed", "400"], ["--max-speed"]),
@@ -54,6 +56,18 @@ def test_bad_options_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureF
                                          args: list[str], words: list[str]) -> None:
     assert run_track(DEMO, tmp_path / "out", *args) == 2
     _one_line_error(capsys, *words)
+
+
+@pytest.mark.parametrize("backbone, head, wrong", [
+    (b"junk!", fake_onnx.head_bytes(), "nanotrack_backbone_sim.onnx: not a readable ONNX network"),
+    (fake_onnx.head_bytes(), fake_onnx.backbone_bytes(), "nanotrack_backbone_sim.onnx: not NanoTrack's backbone"),
+    (fake_onnx.backbone_bytes(), fake_onnx.backbone_bytes(), "nanotrack_head_sim.onnx: not NanoTrack's neck/head"),
+])
+def test_wrong_model_files_are_named_in_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                 backbone: bytes, head: bytes, wrong: str) -> None:
+    models = fake_onnx.write_nanotrack_files(tmp_path / "models", backbone, head)  # once a cv2.error traceback
+    assert run_track(DEMO, tmp_path / "out", "--roi", DEMO_ROI, "--model-dir", str(models)) == 2
+    _one_line_error(capsys, wrong)
 
 
 def test_missing_and_garbage_sources(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,12 +1,15 @@
 """Hand-computed IoU, precision and success-AUC cases."""
+import json
+import math
+
 import cv2
 import pytest
 
 from tracker.boxes import iou, polygon_to_box
 from tracker.datasets import Sequence
 from tracker.estimate import TargetEstimate, TrackState
-from tracker.evaluation import PERTURBED_STARTS, perturbed_box, run_sequence
-from tracker.metrics import SUCCESS_THRESHOLDS, precision_at, success_auc, success_curve
+from tracker.evaluation import PERTURBED_STARTS, perturbed_box, run_sequence, summarize
+from tracker.metrics import SUCCESS_THRESHOLDS, has_truth, precision_at, success_auc, success_curve
 from tracker.synthetic import render_sequence
 
 
@@ -42,6 +45,31 @@ def test_precision_counts_centre_errors_up_to_the_limit():
     assert precision_at(predicted, truth) == pytest.approx(0.75)  # errors 0, 20, 20, 21
 
 
+NAN_BOX = (math.nan,) * 4
+
+
+def test_a_box_without_width_height_or_finite_values_is_no_ground_truth():
+    assert has_truth((0, 0, 10, 10)) and has_truth((-5, -5, 0.5, 1))
+    for box in (NAN_BOX, (0, 0, 0, 0), (3, 4, 0, 10), (3, 4, 10, -1), (math.inf, 0, 10, 10)):
+        assert not has_truth(box)
+
+
+def test_frames_without_ground_truth_are_left_out_of_both_scores():
+    """NaN and 0,0,0,0 boxes (subject not visible) count neither as misses nor as hits (pytracking's
+    OTB-style convention): a tracker exact on the other frames scores as a perfect one."""
+    truth = [(10, 10, 20, 20), NAN_BOX, (0, 0, 0, 0), (10, 10, 20, 20)]
+    predicted = [(10, 10, 20, 20)] * 4
+    assert precision_at(predicted, truth) == 1.0  # was 0.5
+    assert success_auc(predicted, truth) == pytest.approx(20 / 21)  # was 10 / 21
+    far = [(10, 10, 20, 20), (10, 10, 20, 20), (10, 10, 20, 20), (200, 200, 20, 20)]
+    assert precision_at(far, truth) == 0.5 and success_curve(far, truth)[0] == 0.5
+
+
+def test_no_frame_with_ground_truth_is_an_error():
+    with pytest.raises(ValueError, match="no frame has a ground-truth box"):
+        success_auc([(0, 0, 1, 1)], [(0, 0, 0, 0)])
+
+
 def test_mismatched_lengths_are_rejected():
     with pytest.raises(ValueError, match="equal"):
         success_auc([(0, 0, 1, 1)], [])
@@ -71,3 +99,42 @@ def test_run_sequence_starts_from_the_given_box(tmp_path):
 
     result = run_sequence(Recorder(), sequence, start=start)
     assert recorded == [start] and result.boxes[0] == start
+
+
+def _sequence_on_disk(folder, frames: int, boxes=None) -> Sequence:
+    folder.mkdir(exist_ok=True)
+    seq = render_sequence(frames=frames, seed=0)
+    paths = tuple(folder / f"{i}.png" for i in range(frames))
+    for path, frame in zip(paths, seq.frames):
+        cv2.imwrite(str(path), frame)
+    return Sequence("synthetic", frame_paths=paths, groundtruth=tuple(boxes or seq.boxes))
+
+
+class _Still:
+    def init(self, frame, box, timestamp):
+        self.box = box
+
+    def update(self, frame, timestamp):
+        return TargetEstimate(self.box, (0.0, 0.0), 1.0, TrackState.TRACKING, timestamp, 0)
+
+
+@pytest.mark.parametrize("first", [NAN_BOX, (0.0, 0.0, 0.0, 0.0), (10.0, 10.0, 0.0, 5.0)])
+def test_run_sequence_refuses_a_missing_or_empty_first_box(tmp_path, first):
+    sequence = _sequence_on_disk(tmp_path, 2, [first, (10.0, 10.0, 20.0, 20.0)])
+    with pytest.raises(ValueError, match="synthetic: the first ground-truth box .* is missing or empty"):
+        run_sequence(_Still(), sequence)  # NaN: once a ValueError deep in the tracker; 0,0,0,0: once scored
+
+
+def test_fps_of_a_one_frame_sequence_is_none_in_the_json_rows(tmp_path):
+    result = run_sequence(_Still(), _sequence_on_disk(tmp_path, 1))
+    assert math.isnan(result.fps) and math.isnan(result.cpu_fps)  # nothing was timed; once infinite
+    assert result.as_dict()["fps"] is None
+    summary = summarize([result])
+    assert summary["fps"] is None and summary["cpu_fps"] is None
+    json.dumps([result.as_dict(), summary], allow_nan=False)  # strict JSON: no Infinity, no NaN
+
+
+def test_summary_fps_is_the_median_of_the_measured_sequences(tmp_path):
+    one = run_sequence(_Still(), _sequence_on_disk(tmp_path / "one", 1))
+    three = run_sequence(_Still(), _sequence_on_disk(tmp_path, 3))
+    assert summarize([one, three])["fps"] == round(three.fps, 1) > 0

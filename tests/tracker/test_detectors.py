@@ -1,9 +1,12 @@
 """Detectors: motion on rendered frames; face and person construct and run."""
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
 from tracker.boxes import iou
-from tracker.detectors import Detection, make_detector
+from tracker.detectors import Detection, HaarFaceDetector, make_detector
 from tracker.synthetic import render_sequence, texture
 
 
@@ -42,11 +45,28 @@ def test_builtin_detectors_need_no_model_files_and_run(kind):
     assert all(isinstance(d, Detection) and 0.0 <= d.score <= 1.0 for d in found)
 
 
-def test_unknown_kind_and_missing_yunet_model(tmp_path):
+def test_unknown_kind(tmp_path):
     with pytest.raises(ValueError, match="unknown detector kind 'cat'"):
         make_detector("cat")
-    with pytest.raises(FileNotFoundError, match="face_detection_yunet"):
-        make_detector("face", tmp_path)
+
+
+def test_a_model_dir_without_yunet_falls_back_to_haar(tmp_path):
+    """As documented: YuNet only when the folder holds its file (e.g. not a NanoTrack-only folder)."""
+    (tmp_path / "nanotrack_v2").mkdir()
+    (tmp_path / "nanotrack_v2" / "nanotrack_backbone_sim.onnx").write_bytes(b"")
+    assert isinstance(make_detector("face", tmp_path), HaarFaceDetector)  # once a FileNotFoundError
+
+
+def test_person_detector_gives_nothing_on_frames_smaller_than_its_window():
+    """In a child process: on such frames OpenCV's HOG once corrupted memory and aborted the process
+    (and a 0 x 0 frame divided by zero)."""
+    code = ("import numpy as np; from tracker.detectors import make_detector; d = make_detector('person'); "
+            "sizes = [(0, 0), (8, 8), (16, 16), (24, 24), (32, 32), (127, 64), (128, 63), (40, 2000)]; "
+            "print([d.detect(np.zeros((h, w, 3), np.uint8)) for h, w in sizes]); "
+            "print(isinstance(d.detect(np.zeros((128, 64, 3), np.uint8)), list))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["[[],"] + ["[],"] * 6 + ["[]]", "True"]
 
 
 def test_yunet_loads_from_the_shared_models(shared_data):

@@ -5,8 +5,11 @@ import pytest
 
 from tracker.boxes import iou
 from tracker.metrics import success_auc
+from tests import fake_onnx
+from tracker.backends import make_backend
 from tracker.nanotrack import (SCORE_SIZE, NanoTrackBackend, NanoTrackParams, change_penalty, crop_square,
-                               decode_boxes, foreground_score, grid_offsets, hanning_window, select_peak)
+                               decode_boxes, foreground_score, grid_offsets, hanning_window,
+                               load_nanotrack_networks, select_peak)
 from tracker.subject import SubjectTracker
 from tracker.synthetic import render_sequence
 
@@ -93,6 +96,31 @@ def test_missing_model_files_raise_file_not_found(tmp_path):
         NanoTrackBackend(tmp_path)
     with pytest.raises(FileNotFoundError):
         NanoTrackBackend(None)
+
+
+def test_networks_shaped_like_nanotracks_pass_the_load_check(tmp_path):
+    models = fake_onnx.write_nanotrack_files(tmp_path, fake_onnx.backbone_bytes(), fake_onnx.head_bytes())
+    backbone, head = load_nanotrack_networks(models)
+    assert not backbone.empty() and not head.empty()
+    backend = NanoTrackBackend(models)
+    frame = render_sequence(frames=1, seed=1).frames[0]
+    backend.init(frame, (100.0, 80.0, 40.0, 40.0))
+    box, score = backend.update(frame)
+    assert box is not None and 0.0 <= score <= 1.0
+
+
+@pytest.mark.parametrize("backbone, head, wrong", [
+    (b"junk!", fake_onnx.head_bytes(), r"backbone .*nanotrack_backbone_sim.onnx: not a readable ONNX network"),
+    (fake_onnx.backbone_bytes(), b"", r"neck/head .*nanotrack_head_sim.onnx: not a readable ONNX network"),
+    (fake_onnx.head_bytes(), fake_onnx.backbone_bytes(), r"nanotrack_backbone_sim.onnx: not NanoTrack's backbone"),
+    (fake_onnx.backbone_bytes(), fake_onnx.backbone_bytes(), r"nanotrack_head_sim.onnx: not NanoTrack's neck/head"),
+])
+@pytest.mark.parametrize("name", ["nanotrack", "nano"])
+def test_wrong_or_damaged_model_files_are_named_when_the_backend_is_made(tmp_path, backbone, head, wrong, name):
+    """Once a cv2.error: on loading (junk), on the first search (swapped) or in init() (``nano``)."""
+    models = fake_onnx.write_nanotrack_files(tmp_path, backbone, head)
+    with pytest.raises(ValueError, match=wrong):
+        make_backend(name, models)
 
 
 def test_update_before_init_is_an_error(shared_data):

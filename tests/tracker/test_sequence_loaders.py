@@ -5,7 +5,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tracker.datasets import list_images, load_sequence, parse_groundtruth
+from tracker.datasets import FrameReadError, list_images, load_sequence, parse_groundtruth
 
 
 def _write_frames(folder: Path, count: int, name: str = "{:04d}.jpg") -> None:
@@ -30,6 +30,26 @@ def test_wrong_value_count_names_the_line(tmp_path):
     (tmp_path / "gt.txt").write_text("1,2,3,4\n1,2,3\n")
     with pytest.raises(ValueError, match=r"gt.txt:2"):
         parse_groundtruth(tmp_path / "gt.txt")
+
+
+def test_a_utf8_byte_order_mark_is_ignored(tmp_path):
+    (tmp_path / "gt.txt").write_text("\ufeff1,2,3,4\n5,6,7,8\n", encoding="utf-8")  # Windows Notepad
+    assert parse_groundtruth(tmp_path / "gt.txt") == ((1, 2, 3, 4), (5, 6, 7, 8))
+
+
+def test_a_blank_line_before_the_last_box_is_an_error_naming_it(tmp_path):
+    """Skipped, it would pair every later box with the frame before its own."""
+    (tmp_path / "gt.txt").write_text("1,2,3,4\n\n5,6,7,8\n")
+    with pytest.raises(ValueError, match=r"gt.txt:2: blank line"):
+        parse_groundtruth(tmp_path / "gt.txt")
+    (tmp_path / "end.txt").write_text("1,2,3,4\r\n5,6,7,8\r\n\r\n \n")  # blank lines at the end are fine
+    assert parse_groundtruth(tmp_path / "end.txt") == ((1, 2, 3, 4), (5, 6, 7, 8))
+
+
+def test_nan_lines_are_frames_without_the_subject(tmp_path):
+    (tmp_path / "gt.txt").write_text("1,2,3,4\nNaN,NaN,NaN,NaN\n0,0,0,0\n")
+    boxes = parse_groundtruth(tmp_path / "gt.txt")
+    assert len(boxes) == 3 and all(np.isnan(boxes[1])) and boxes[2] == (0, 0, 0, 0)
 
 
 def test_otb_folder(tmp_path):
@@ -73,19 +93,52 @@ def test_more_boxes_than_frames_is_an_error(tmp_path):
         load_sequence(tmp_path)
 
 
+def test_fewer_boxes_than_frames_is_an_error(tmp_path):
+    """Not scored against frames 1..n: an annotation may start at a later frame (OTB-2015's David)."""
+    _write_frames(tmp_path / "img", 3)
+    (tmp_path / "groundtruth_rect.txt").write_text("1,2,3,4\n" * 2)
+    with pytest.raises(ValueError, match="2 boxes but .* has 3 frames: one box per frame"):
+        load_sequence(tmp_path)
+    (tmp_path / "video").mkdir()
+    _write_video(tmp_path / "video" / "clip.avi", 5)
+    (tmp_path / "video" / "clip.txt").write_text("1,2,3,4\n" * 4)
+    with pytest.raises(ValueError, match="4 boxes but .*clip.avi has 5 frames"):
+        load_sequence(tmp_path / "video" / "clip.avi")
+
+
+def test_an_unreadable_frame_names_the_sequence_and_the_frame(tmp_path):
+    _write_frames(tmp_path / "seq" / "img", 3)
+    (tmp_path / "seq" / "img" / "0002.jpg").write_bytes(b"not a jpeg")
+    (tmp_path / "seq" / "groundtruth_rect.txt").write_text("1,2,3,4\n" * 3)
+    frames = load_sequence(tmp_path / "seq").frames()
+    assert next(frames).shape == (24, 32, 3)
+    with pytest.raises(FrameReadError, match=r"seq: cannot read frame 2 \(.*0002.jpg\)"):
+        next(frames)
+
+
+def test_a_video_ending_early_names_the_sequence_and_the_frame(tmp_path):
+    _write_video(tmp_path / "full.avi", 30)
+    data = (tmp_path / "full.avi").read_bytes()
+    (tmp_path / "clip.avi").write_bytes(data[:len(data) // 2])  # its header still says 30 frames
+    (tmp_path / "clip.txt").write_text("1,2,3,4\n" * 30)
+    frames = load_sequence(tmp_path / "clip.avi").frames()
+    with pytest.raises(FrameReadError, match=r"clip: cannot read frame \d+ of the 30 in .*clip.avi"):
+        list(frames)  # once: fewer frames, silently
+
+
 def _write_video(path: Path, count: int) -> None:
     writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 25, (32, 24))
     for i in range(count):
-        writer.write(np.full((24, 32, 3), i * 30, np.uint8))
+        writer.write(np.full((24, 32, 3), i * 30 % 256, np.uint8))
     writer.release()
 
 
 @pytest.mark.parametrize("name", ["clip.txt", "clip_groundtruth.txt"])
 def test_video_with_groundtruth_beside_it(tmp_path, name):
     _write_video(tmp_path / "clip.avi", 5)
-    (tmp_path / name).write_text("1,2,3,4\n" * 4)
+    (tmp_path / name).write_text("1,2,3,4\n" * 5)
     seq = load_sequence(tmp_path / "clip.avi")
-    assert len(seq) == 4 and len(list(seq.frames())) == 4
+    assert len(seq) == 5 and len(list(seq.frames())) == 5
 
 
 def test_video_with_given_groundtruth(tmp_path):

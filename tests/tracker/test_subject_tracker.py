@@ -3,10 +3,10 @@ import numpy as np
 import pytest
 
 from tracker.registry import available_trackers, make_tracker
-from tracker.boxes import iou
+from tracker.boxes import center, iou
 from tracker.estimate import TrackState
 from tracker.metrics import success_auc
-from tracker.synthetic import render_sequence
+from tracker.synthetic import render_sequence, texture
 
 FPS = 30.0
 
@@ -128,3 +128,44 @@ def test_a_backends_numerical_failure_is_a_miss_not_a_measurement():
                for e in estimates)
     assert [e.state for e in estimates[9:11]] == [TrackState.SEARCHING] * 2
     assert estimates[-1].state is TrackState.TRACKING and iou(estimates[-1].box, seq.boxes[-1]) > 0.7
+
+
+def test_the_default_tracker_stays_lost_once_the_subject_has_gone():
+    """With the subject gone for good, the backend's score must not recover on the background
+    (its typical peak used to sink to the background's level within ~60 frames)."""
+    seq = render_sequence(frames=20, speed=2.0)
+    background = texture(240, 320, np.random.default_rng(0), cell=16, contrast=0.35)  # the scene, no subject
+    subject = make_tracker("default")
+    subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    for i, frame in enumerate(seq.frames[1:], 1):
+        subject.update(frame, i / FPS)
+    states = [subject.update(background, i / FPS).state for i in range(20, 200)]
+    assert TrackState.LOST in states
+    assert TrackState.TRACKING not in states[states.index(TrackState.LOST):]
+
+
+@pytest.mark.parametrize("name", ["default", "csrt-fast", "mil"])
+def test_a_start_box_over_the_frame_edge_is_followed_where_it_is(name):
+    """A subject half out of the picture is started on as given (the trackers that need a box
+    inside get the visible part), not on a patch moved inside the frame."""
+    seq = render_sequence(frames=30, speed=3.0)
+    cut = 60  # the frame's left 60 px removed: the first box reaches 16 px over the left edge
+    frames = [np.ascontiguousarray(f[:, cut:]) for f in seq.frames]
+    truth = [(b[0] - cut, b[1], b[2], b[3]) for b in seq.boxes]
+    assert truth[0][0] < 0
+    subject = make_tracker(name)
+    first = subject.init(frames[0], truth[0], 0.0)
+    boxes = [first.box] + [subject.update(f, i / FPS).box for i, f in enumerate(frames[1:], 1)]
+    errors = [abs(center(b)[0] - center(t)[0]) for b, t in zip(boxes, truth)]
+    if name == "default":
+        assert first.box == pytest.approx(truth[0])
+        assert success_auc(boxes, truth) > 0.8  # 0.44 when the box was moved inside
+        assert max(errors) < 4  # 16 px when moved
+    else:  # MIL crashed on a box over the edge
+        assert max(errors) < 20
+
+
+def test_a_start_box_off_the_frame_is_refused():
+    frame = render_sequence(frames=1).frames[0]
+    with pytest.raises(ValueError, match="outside"):
+        make_tracker("default").init(frame, (330, 10, 20, 20), 0.0)
