@@ -260,11 +260,16 @@ class TrackSession:
     def _start_recording(self) -> None:
         try:
             self.client.start_recording()
-            self.recording["started"] = True
-            self.recording["start_confirmed"] = self.client.camera_status() is True
         except GimbalError as exc:
             self.recording["started"] = False
             self.recording["error"] = str(exc)
+            return
+        self.recording["started"] = True  # so the stop goes out at the end, confirmed or not
+        try:
+            self.recording["start_confirmed"] = self.client.camera_status() is True
+        except GimbalError as exc:
+            self.recording["start_confirmed"] = False
+            self.recording["status_query_error"] = str(exc)
 
     def _stop_recording(self) -> None:
         if self.recording["requested"] and self.first_acquired_s is None:
@@ -274,11 +279,16 @@ class TrackSession:
             return
         try:
             self.client.stop_recording()
-            self.recording["stopped"] = True
-            self.recording["stop_confirmed"] = self.client.camera_status() is False
         except GimbalError as exc:
             self.recording["stopped"] = False
             self.recording["error"] = str(exc)
+            return
+        self.recording["stopped"] = True
+        try:
+            self.recording["stop_confirmed"] = self.client.camera_status() is False
+        except GimbalError as exc:
+            self.recording["stop_confirmed"] = False
+            self.recording["status_query_error"] = str(exc)
 
     # -- the end -------------------------------------------------------------------------
     def finish(self, reason: str | None = None, error: str | None = None) -> dict[str, Any]:
@@ -302,7 +312,10 @@ class TrackSession:
             self.recording["error"] = str(exc)
         self._progress.update(self.frames, self.reason, force=True)
         self._progress.close()
-        self.telemetry.close()
+        try:
+            self.telemetry.close()
+        except OSError as exc:  # a full disk: what was flushed before is kept
+            self.reason, self.error = "output failed", self.error or f"telemetry: {exc.strerror or exc}"
         if self.video is not None:
             self.video.close()
         summary = self.write_summary()

@@ -181,6 +181,9 @@ def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, w
         session.finish("gimbal not answering", str(exc))
         raise CliError(f"the gimbal does not answer on {where} ({exc}); check the "
                        "wiring, bitrate (1 Mbit/s) and ids", exit_code=1) from None
+    except GimbalError as exc:  # a NACK or an undecodable answer to the start-up commands
+        session.finish("gimbal refused to start", str(exc))
+        raise CliError(f"the gimbal on {where} refused to start ({exc})", exit_code=1) from None
     return session
 
 

@@ -11,6 +11,8 @@ from pathlib import Path
 import pytest
 
 import gimbal.sim
+from gimbal.client import GimbalClient
+from gimbal.errors import ReturnCodeError
 import pipelines.cli.bus
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
@@ -178,3 +180,43 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
     assert_stopped_at_end(records)
     final = json.loads(sim_out.strip().splitlines()[-1])
     assert final["speeds"] == [0.0, 0.0, 0.0] and not final["moving"] and not final["speed_control"]
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_telemetry_that_cannot_be_written_ends_with_a_summary_not_a_traceback(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "telemetry.jsonl").symlink_to("/dev/full")
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and err.strip().splitlines()[-1].startswith("gimbaltrack track: error:")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "output failed"
+    assert_stopped_at_end(decoded(out / "can.log"))
+
+
+def test_a_gimbal_refusing_the_start_up_commands_is_one_line(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    real = gimbal.sim.start_in_process
+    monkeypatch.setattr(pipelines.cli.bus, "start_in_process",
+                        lambda config=None, faults=None: real(config, Faults(nack=1.0)))
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
+    _one_line_error(capsys, "refused to start", "0x02")
+    assert json.loads((out / "summary.json").read_text())["status"] == "gimbal refused to start"
+
+
+def test_a_recording_started_but_not_confirmed_is_still_stopped(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuse(self):  # type: ignore[no-untyped-def]
+        raise ReturnCodeError("camera_status_query", 0x02)
+
+    monkeypatch.setattr(GimbalClient, "camera_status", refuse)
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video", "--record", "--max-frames", "30") == 0
+    recording = json.loads((out / "summary.json").read_text())["recording"]
+    assert recording["started"] is True and recording["start_confirmed"] is False
+    assert recording["stopped"] is True
+    actions = [r["fields"]["action"] for r in decoded(out / "can.log") if r.get("name") == "camera_action"]
+    assert actions == [3, 4]  # start, then stop at the end
