@@ -10,6 +10,7 @@ import logging
 import math
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -258,18 +259,7 @@ class TrackSession:
 
     # -- recording -----------------------------------------------------------------------
     def _start_recording(self) -> None:
-        try:
-            self.client.start_recording()
-        except GimbalError as exc:
-            self.recording["started"] = False
-            self.recording["error"] = str(exc)
-            return
-        self.recording["started"] = True  # so the stop goes out at the end, confirmed or not
-        try:
-            self.recording["start_confirmed"] = self.client.camera_status() is True
-        except GimbalError as exc:
-            self.recording["start_confirmed"] = False
-            self.recording["status_query_error"] = str(exc)
+        self._camera_action(self.client.start_recording, "started", "start_confirmed", recording=True)
 
     def _stop_recording(self) -> None:
         if self.recording["requested"] and self.first_acquired_s is None:
@@ -277,17 +267,22 @@ class TrackSession:
             self.recording["error"] = "the subject was never acquired"
         if not self.recording.get("started"):
             return
+        self._camera_action(self.client.stop_recording, "stopped", "stop_confirmed", recording=False)
+
+    def _camera_action(self, action: Callable[[], None], done: str, confirmed: str, recording: bool) -> None:
+        """Send a record start or stop, then ask the camera whether it is ``recording``. An answered
+        action counts as done (so a start is always followed by a stop), confirmed or not."""
         try:
-            self.client.stop_recording()
+            action()
         except GimbalError as exc:
-            self.recording["stopped"] = False
+            self.recording[done] = False
             self.recording["error"] = str(exc)
             return
-        self.recording["stopped"] = True
+        self.recording[done] = True
         try:
-            self.recording["stop_confirmed"] = self.client.camera_status() is False
+            self.recording[confirmed] = self.client.camera_status() is recording
         except GimbalError as exc:
-            self.recording["stop_confirmed"] = False
+            self.recording[confirmed] = False
             self.recording["status_query_error"] = str(exc)
 
     # -- the end -------------------------------------------------------------------------
