@@ -28,7 +28,7 @@ def open_source(spec: str, realtime: bool = False, *, fps: float | None = None,
     and ``clock``: their timestamps are ``time.monotonic()`` at grab, and a live source that delivers
     nothing for ``stall_timeout`` s raises ``SourceError("stream stalled ...")``.
     """
-    if spec.isdigit():
+    if spec.isascii() and spec.isdigit():
         return open_camera(int(spec), stall_timeout, open_timeout)
     if _URL.match(spec):
         return open_stream(spec, stall_timeout, open_timeout)

@@ -13,6 +13,7 @@ from pipelines.sources.base import Frame, FrameSource, SourceError, nominal_fps
 
 DEFAULT_STALL_TIMEOUT = 2.0
 DEFAULT_OPEN_TIMEOUT = 10.0
+MAX_CAMERA_INDEX = 100
 
 
 class Capture(Protocol):
@@ -140,10 +141,61 @@ class LiveSource(FrameSource):
             self._grabber.stop()
 
 
+class _Opening:
+    """A capture being opened on a helper thread; released there if nobody waits for it any more."""
+
+    def __init__(self, open_capture: Callable[[], cv2.VideoCapture]) -> None:
+        self._open_capture = open_capture
+        self._lock = threading.Lock()
+        self._done = threading.Event()
+        self._capture: cv2.VideoCapture | None = None
+        self._error: BaseException | None = None
+        self._abandoned = False
+
+    def run(self) -> None:
+        try:
+            capture = self._open_capture()
+        except BaseException as exc:  # handed to the waiter (cv2.error, a bad argument...)
+            capture, self._error = None, exc
+        with self._lock:
+            self._capture = capture
+            abandoned = self._abandoned
+        self._done.set()
+        if abandoned and capture is not None:
+            capture.release()
+
+    def wait(self) -> cv2.VideoCapture:
+        try:
+            self._done.wait()
+        except BaseException:
+            with self._lock:
+                self._abandoned = True
+                capture = self._capture
+            if capture is not None:
+                capture.release()
+            raise
+        if self._error is not None:
+            raise self._error
+        assert self._capture is not None
+        return self._capture
+
+
+def open_interruptibly(open_capture: Callable[[], cv2.VideoCapture]) -> cv2.VideoCapture:
+    """``open_capture()`` on a helper thread, waited for here: OpenCV blocks while it opens (up to
+    its open timeout for a stream), and on the main thread that would hold off a Ctrl-C or SIGTERM
+    until it returned. A wait cut short by a signal's exception leaves the capture to be released
+    as soon as it opens."""
+    opening = _Opening(open_capture)
+    threading.Thread(target=opening.run, name="capture-open", daemon=True).start()
+    return opening.wait()
+
+
 def open_camera(index: int, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
                 open_timeout: float = DEFAULT_OPEN_TIMEOUT) -> LiveSource:
-    """Camera number ``index`` through OpenCV's default backend."""
-    capture = cv2.VideoCapture(index)
+    """Camera number ``index`` (0 to 99) through OpenCV's default backend."""
+    if not 0 <= index < MAX_CAMERA_INDEX:  # OpenCV reads the hundreds of an index as a backend's number
+        raise SourceError(f"camera index {index} is out of range (0 to {MAX_CAMERA_INDEX - 1})")
+    capture = open_interruptibly(lambda: cv2.VideoCapture(index))
     if not capture.isOpened():
         raise SourceError(f"camera {index} does not open (not connected, busy or no permission)")
     return LiveSource(capture, f"camera {index}", nominal_fps(capture), stall_timeout, open_timeout)
@@ -155,7 +207,7 @@ def open_stream(url: str, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
     params = [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(open_timeout * 1000),
               cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(stall_timeout * 1000)]
     started = time.monotonic()
-    capture = cv2.VideoCapture(url, cv2.CAP_FFMPEG, params)
+    capture = open_interruptibly(lambda: cv2.VideoCapture(url, cv2.CAP_FFMPEG, params))
     if not capture.isOpened():
         if time.monotonic() - started >= open_timeout:
             raise SourceError(f"cannot open stream {url}: nothing received within {open_timeout:g} s")

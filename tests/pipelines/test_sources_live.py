@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import itertools
+import os
+import signal
 import socket
 import subprocess
 import threading
@@ -12,7 +14,7 @@ import numpy as np
 import pytest
 
 from pipelines.sources import SourceError, open_source
-from pipelines.sources.live import LatestFrameGrabber, LiveSource
+from pipelines.sources.live import LatestFrameGrabber, LiveSource, open_interruptibly
 from tests.support import free_udp_port, require_ffmpeg
 
 WAIT = 10.0  # generous bound for thread hand-offs; tests never assert on durations
@@ -116,6 +118,59 @@ def test_live_source_that_never_delivers_does_not_open() -> None:
 def test_camera_that_does_not_open() -> None:
     with pytest.raises(SourceError, match="camera 97 does not open"):
         open_source("97")
+
+
+@pytest.mark.parametrize("spec", ["99999999999", "100", "\u00b2"])  # once tracebacks from OpenCV or int()
+def test_camera_indexes_opencv_cannot_take_are_one_line_errors(spec: str) -> None:
+    with pytest.raises(SourceError, match="out of range|no such video file"):
+        open_source(spec)
+
+
+class _Stop(Exception):
+    pass
+
+
+class _SlowToOpen:
+    """A capture whose opening blocks until ``finish`` is set, like OpenCV's on a silent stream."""
+
+    def __init__(self) -> None:
+        self.finish = threading.Event()
+        self.released = threading.Event()
+
+    def open(self) -> "_SlowToOpen":
+        self.finish.wait(WAIT)
+        return self
+
+    def release(self) -> None:
+        self.released.set()
+
+
+def test_a_signal_ends_the_wait_for_a_capture_that_is_still_opening() -> None:
+    """OpenCV's blocking open on the main thread once held off Ctrl-C for the whole open timeout."""
+    def stop(signum: int, frame: object) -> None:
+        raise _Stop
+
+    capture = _SlowToOpen()
+    previous = signal.signal(signal.SIGUSR1, stop)
+    timer = threading.Timer(0.1, os.kill, (os.getpid(), signal.SIGUSR1))
+    try:
+        timer.start()
+        with pytest.raises(_Stop):
+            open_interruptibly(capture.open)
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGUSR1, previous)
+    assert not capture.released.is_set()
+    capture.finish.set()  # it opens after all: nobody wants it any more
+    assert capture.released.wait(WAIT)
+
+
+def test_an_opened_capture_and_an_opening_error_reach_the_caller() -> None:
+    capture = _SlowToOpen()
+    capture.finish.set()
+    assert open_interruptibly(capture.open) is capture and not capture.released.is_set()
+    with pytest.raises(ZeroDivisionError):
+        open_interruptibly(lambda: 1 // 0)
 
 
 def test_refused_stream_is_not_called_a_timeout() -> None:
