@@ -307,30 +307,51 @@ class TrackSession:
             self.recording["error"] = str(exc)
         self._progress.update(self.frames, self.reason, force=True)
         self._progress.close()
-        try:
-            self.telemetry.close()
-        except OSError as exc:  # a full disk: what was flushed before is kept
-            self.reason, self.error = "output failed", self.error or f"telemetry: {exc.strerror or exc}"
+        self._finalise("telemetry", self.telemetry.close)  # what was flushed before a failure is kept
         if self.video is not None:
-            self.video.close()
-        summary = self.write_summary()
-        if self.series.t:
-            s = self.series
-            write_timeseries_png(
-                self.paths["plot"], s.t,
-                [{"yaw": s.yaw_error, "pitch": s.pitch_error}, {"yaw": s.yaw_rate, "pitch": s.pitch_rate}],
-                titles=["angular error (target - pointing)", "commanded rates"],
-                ylabels=["deg", "deg/s"])
-        return summary
+            self._finalise("annotated video", self.video.close)
+        if self.series.t and not self._finalise("plot", self._write_plot):
+            del self.paths["plot"]
+        try:
+            return self.write_summary()
+        except OSError as exc:  # the previous rewrite, if any, stays in place
+            self._output_failed("summary", exc)
+            return self._summary()
+
+    def _finalise(self, what: str, step: Callable[[], None]) -> bool:
+        """Run an output's last step; a failure (a full disk) is recorded and the others still run."""
+        try:
+            step()
+        except OSError as exc:
+            self._output_failed(what, exc)
+            return False
+        return True
+
+    def _output_failed(self, what: str, exc: OSError) -> None:
+        self.reason, self.error = "output failed", self.error or f"{what}: {exc.strerror or exc}"
+
+    def _write_plot(self) -> None:
+        s = self.series
+        write_timeseries_png(
+            self.paths["plot"], s.t,
+            [{"yaw": s.yaw_error, "pitch": s.pitch_error}, {"yaw": s.yaw_rate, "pitch": s.pitch_rate}],
+            titles=["angular error (target - pointing)", "commanded rates"],
+            ylabels=["deg", "deg/s"])
 
     def write_summary(self, sync: bool = True) -> dict[str, Any]:
         """Write the summary as it stands (atomically; ``sync``: fsync it) and return it."""
         self._last_summary = time.monotonic()
-        elapsed = self._last_summary - self._started
+        summary = self._summary()
+        write_summary(self.paths["summary"], summary, sync)
+        return summary
+
+    def _summary(self) -> dict[str, Any]:
+        """The summary as it stands."""
+        elapsed = time.monotonic() - self._started
         streamer = self._streamer
         latencies = streamer.latencies() if streamer is not None else []
         s = self.series
-        summary = {
+        return {
             "status": self.reason, "error": self.error,
             "source": self.source.description, "live": self.source.is_live,
             "bus": self.bus_description, "tracker": self.tracker.name, "controller": self.options.controller,
@@ -348,5 +369,3 @@ class TrackSession:
             "recording": self.recording,
             "outputs": {k: str(v) for k, v in self.paths.items()},
         }
-        write_summary(self.paths["summary"], summary, sync)
-        return summary

@@ -6,13 +6,14 @@ import dataclasses
 import json
 import math
 import sys
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
 from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
-from gimbal.signals import SignalExit
+from gimbal.signals import SignalExit, deferred_signals
 from pipelines.acquire import PICKS, parse_roi, roi_in_frame
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
@@ -35,7 +36,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "log, summary, plot) are written to --out as the run goes.",
         epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
         "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
-        "  gimbaltrack track udp://127.0.0.1:5000 --detect person --realtime\n\n"
+        "  gimbaltrack track udp://127.0.0.1:5000 --detect person\n"
+        "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n\n"
         "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png\n"
         "exit status: 0 done; 1 the gimbal, bus, source or an output failed mid-run; 2 bad input;\n"
         "  130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to stop in every case)",
@@ -133,6 +135,11 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
     except SourceError as exc:
         raise CliError(str(exc)) from None
     with source:
+        ignored = [name for name, given in (("--realtime", args.realtime), ("--fps", args.fps is not None))
+                   if given and source.is_live]
+        if ignored:
+            print(f"gimbaltrack track: note: ignoring {' and '.join(ignored)} for a live source (it runs at "
+                  "its own rate)", file=sys.stderr)
         if options.roi is not None:
             try:
                 roi = roi_in_frame(options.roi, source.size)
@@ -141,7 +148,10 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             if roi != options.roi:
                 print(f"gimbaltrack track: note: --roi cut to the frame: {','.join(map(str, roi))}", file=sys.stderr)
             options = dataclasses.replace(options, roi=roi)
-        with open_host_bus(args) as bus:
+        with open_host_bus(args) as bus, ExitStack() as held:
+            # from the output folder's creation until a session exists that can finish its outputs,
+            # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
+            held.enter_context(deferred_signals())
             make_out_dir(options.out_dir)
             can_log = _can_log(options.out_dir / "can.log")
             try:
@@ -150,7 +160,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                     where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
                              " ".join(str(v) for v in (args.interface or "python-can's configured bus",
                                                        args.channel) if v))
-                    session = _session(options, source, client, where, can_log)
+                    session = _session(options, source, client, where, can_log, held)
                     return _run(session, args)
             finally:
                 can_log.stop()
@@ -164,12 +174,13 @@ def _can_log(path: Path) -> CanLogWriter:
 
 
 def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, where: str,
-             can_log: CanLogWriter) -> TrackSession:
+             can_log: CanLogWriter, held_signals: ExitStack) -> TrackSession:
     try:
         session = TrackSession(options, source, client, where, can_log)
     except (ValueError, FileNotFoundError, OSError) as exc:
         raise CliError(str(exc)) from None
     try:
+        held_signals.close()  # a signal held while the outputs were opened arrives here
         session.start()
     except KeyboardInterrupt:
         session.finish("interrupted while starting (SIGINT)")
@@ -201,13 +212,20 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
         raise CliError(f"{exc} (outputs so far are in {session.options.out_dir})", exit_code=1) from None
     except (GimbalError, OSError) as exc:
         session.finish("gimbal or bus failed" if isinstance(exc, GimbalError) else "output failed", str(exc))
-        raise CliError(f"{exc} (the gimbal was told to stop; outputs so far are in "
-                       f"{session.options.out_dir})", exit_code=1) from None
+        raise _stopped_with(exc, session) from None
     except Exception as exc:  # a bug: keep the outputs and stop the gimbal, then let it show
         session.finish("failed", repr(exc))
         raise
-    _report(session.finish(), args)
+    summary = session.finish()
+    if summary["status"] == "output failed":  # an output that could not be finalised (a full disk)
+        raise _stopped_with(summary["error"], session)
+    _report(summary, args)
     return 0
+
+
+def _stopped_with(error: object, session: TrackSession) -> CliError:
+    return CliError(f"{error} (the gimbal was told to stop; outputs so far are in {session.options.out_dir})",
+                    exit_code=1)
 
 
 #: A file that ends before this share of the frames its header announces was probably cut short.

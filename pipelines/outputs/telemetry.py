@@ -34,8 +34,11 @@ class TelemetryWriter:
     def write(self, record: Mapping[str, Any]) -> None:
         """Write ``record`` (numpy values, enums and tuples allowed; NaN is written as null)."""
         line = json.dumps(to_plain(record), separators=(",", ":"), allow_nan=False)
-        self._file.write(line + "\n")
-        self._file.flush()
+        try:
+            self._file.write(line + "\n")
+            self._file.flush()
+        except OSError as exc:
+            raise OSError(f"cannot write the telemetry {self.path}: {exc.strerror or exc}") from exc
         self.records += 1
 
     def close(self) -> None:

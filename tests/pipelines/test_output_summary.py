@@ -1,6 +1,7 @@
 """Summary JSON (atomic rewrites) and latency percentiles."""
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
@@ -9,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import pipelines.outputs.summary
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
 
@@ -63,3 +65,22 @@ def test_latency_percentiles() -> None:
 def test_latency_percentiles_ignore_non_finite_and_handle_empty() -> None:
     assert latency_percentiles([math.nan, 4.0, math.inf])["p99"] == 4.0
     assert latency_percentiles([]) == {"count": 0, "p50": None, "p95": None, "p99": None, "max": None}
+
+
+def _disk_full(*args: object, **kwargs: object) -> None:
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def test_on_a_full_disk_the_summary_is_rewritten_in_its_own_space(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """No room for the temporary copy once left the summary stale ("running") after a run ended."""
+    path = tmp_path / "summary.json"
+    write_summary(path, {"status": "running", "frames": 1})
+    monkeypatch.setattr(pipelines.outputs.summary, "atomic_write", _disk_full)
+    write_summary(path, {"status": "output failed", "frames": 53})
+    assert json.loads(path.read_text()) == {"status": "output failed", "frames": 53}
+    with pytest.raises(OSError):  # no file yet: no space of its own to reuse
+        write_summary(tmp_path / "new.json", {"status": "running"})
+    with pytest.raises(OSError):  # more than the file's own space
+        write_summary(path, {"status": "x" * 20_000})
+    assert json.loads(path.read_text())["frames"] == 53

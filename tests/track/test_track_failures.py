@@ -3,6 +3,7 @@ and SIGINT/SIGTERM; every time a one-line error, a non-zero exit, the outputs ke
 gimbal told to stop."""
 from __future__ import annotations
 
+import errno
 import json
 import signal
 import time
@@ -14,6 +15,8 @@ import gimbal.sim
 from gimbal.client import GimbalClient
 from gimbal.errors import ReturnCodeError
 import pipelines.cli.bus
+import pipelines.cli.track_cmd
+import pipelines.track_session
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
 from tests import fake_onnx
@@ -220,3 +223,39 @@ def test_a_recording_started_but_not_confirmed_is_still_stopped(
     assert recording["stopped"] is True
     actions = [r["fields"]["action"] for r in decoded(out / "can.log") if r.get("name") == "camera_action"]
     assert actions == [3, 4]  # start, then stop at the end
+
+
+@pytest.mark.parametrize("signum, code, status", [
+    (signal.SIGINT, 130, "interrupted while starting (SIGINT)"),
+    (signal.SIGTERM, 143, "terminated while starting (SIGTERM)"),
+])
+def test_a_signal_just_after_the_output_folder_appears_still_leaves_a_summary(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, signum: int, code: int, status: str) -> None:
+    """A signal before the session existed once ended the run with no summary.json."""
+    real = pipelines.cli.track_cmd.make_out_dir
+
+    def make_then_signal(path: Path) -> None:
+        real(path)
+        signal.raise_signal(signum)
+
+    monkeypatch.setattr(pipelines.cli.track_cmd, "make_out_dir", make_then_signal)
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == code
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == status and summary["frames"] == 0
+
+
+def test_an_output_that_fails_at_the_end_is_one_line_with_the_summary_saying_so(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """A full disk once failed the plot (or the final summary) with a traceback after the last frame."""
+    def disk_full(*args: object, **kwargs: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(pipelines.track_session, "write_timeseries_png", disk_full)
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video", "--max-frames", "20") == 1
+    _one_line_error(capsys, "plot: No space left on device", "the gimbal was told to stop")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "output failed" and summary["frames"] == 20
+    assert "plot" not in summary["outputs"] and not (out / "plot.png").exists()
+    assert_stopped_at_end(decoded(out / "can.log"))

@@ -27,11 +27,13 @@ def test_tracks_a_live_udp_stream(tmp_path: Path, capsys: pytest.CaptureFixture[
          "-f", "mpegts", f"{url}?pkt_size=1316"], cwd=ROOT, stdin=subprocess.DEVNULL)
     out = tmp_path / "out"
     try:
-        code = run_track(url, out, "--detect", "motion", "--max-frames", str(FRAMES), "--json")
+        code = run_track(url, out, "--detect", "motion", "--max-frames", str(FRAMES), "--json", "--realtime")
     finally:
         streamer.kill()
         streamer.wait()
-    assert code == 0, capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert "note: ignoring --realtime for a live source" in err
     summary = json.loads((out / "summary.json").read_text())
     print("live:", json.dumps({k: summary[k] for k in ("fps", "frames_dropped", "latency_ms", "states")}))
     assert summary["live"] is True and summary["attitude_feedback"] is True
