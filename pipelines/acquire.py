@@ -74,13 +74,13 @@ def parse_roi(text: str) -> tuple[int, int, int, int]:
     return x, y, w, h
 
 
-def roi_in_frame(roi: tuple[int, int, int, int], size: tuple[int, int]) -> tuple[int, int, int, int]:
-    """``roi`` cut to the frame of ``size`` (w, h); raises ValueError when less than half of it lies
-    inside (a typo or another clip's coordinates: tracking a background patch would drive the gimbal)."""
+def check_roi_in_frame(roi: tuple[int, int, int, int], size: tuple[int, int]) -> None:
+    """Raise ValueError when less than half of ``roi`` lies inside the frame of ``size`` (w, h): a
+    typo or another clip's coordinates (tracking a background patch would drive the gimbal). A box
+    over an edge is fine as it is: the tracker follows the subject where it is, half out of view."""
     x, y, w, h = roi
     width, height = size
     x0, y0, x1, y1 = max(x, 0), max(y, 0), min(x + w, width), min(y + h, height)
     if x1 <= x0 or y1 <= y0 or (x1 - x0) * (y1 - y0) < 0.5 * w * h:
         raise ValueError(f"--roi {x},{y},{w},{h} lies {'outside' if x1 <= x0 or y1 <= y0 else 'mostly outside'} "
                          f"the {width}x{height} frame")
-    return x0, y0, x1 - x0, y1 - y0

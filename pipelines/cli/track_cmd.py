@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import math
 import sys
@@ -14,7 +13,7 @@ from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit, deferred_signals
-from pipelines.acquire import PICKS, parse_roi, roi_in_frame
+from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
@@ -46,7 +45,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "(udp://, rtsp://, http://)")
     subject = parser.add_argument_group("subject (default: --detect motion, the largest moving thing)")
     start = subject.add_mutually_exclusive_group()
-    start.add_argument("--roi", help="x,y,w,h of the subject in the first frame, in pixels")
+    start.add_argument("--roi", help="x,y,w,h of the subject in the first frame, in pixels (over an edge: "
+                       "--roi=-20,40,64,96)")
     start.add_argument("--detect", choices=("face", "person", "motion"),
                        help="find the subject with a detector (also used to re-acquire it)")
     subject.add_argument("--pick", choices=PICKS,
@@ -142,12 +142,9 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                   "its own rate)", file=sys.stderr)
         if options.roi is not None:
             try:
-                roi = roi_in_frame(options.roi, source.size)
+                check_roi_in_frame(options.roi, source.size)
             except ValueError as exc:
                 raise CliError(str(exc)) from None
-            if roi != options.roi:
-                print(f"gimbaltrack track: note: --roi cut to the frame: {','.join(map(str, roi))}", file=sys.stderr)
-            options = dataclasses.replace(options, roi=roi)
         with open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary

@@ -207,3 +207,12 @@ def test_a_run_into_an_earlier_runs_folder_leaves_none_of_its_outputs(tmp_path: 
     assert run_track(DEMO, out, "--roi", DEMO_ROI, "--max-frames", "5", "--no-video") == 0
     assert not (out / "annotated.avi").exists()  # not a stale video beside the new run's outputs
     assert len(read_telemetry(out / "telemetry.jsonl")) == 5
+
+
+def test_a_roi_over_the_frame_edge_is_tracked_as_given(tmp_path: Path,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """Such a box was once cut to the frame, so the tracker followed a patch offset from the subject."""
+    out = tmp_path / "out"
+    assert run_track(DEMO, out, "--roi=-20,152,64,96", "--max-frames", "3", "--no-video") == 0
+    assert "note" not in capsys.readouterr().err
+    assert read_telemetry(out / "telemetry.jsonl")[0]["box"] == [-20, 152, 64, 96]
