@@ -118,7 +118,7 @@ class SimulatedGimbal:
             data = self._injector.frame(bytes(frame.data), "rx")
             if data is None:
                 return
-            for item in self._framer.feed(data):
+            for item in self._framer.feed_frame(data):
                 if not isinstance(item, Dropped):
                     self._on_packet(item, now)
 

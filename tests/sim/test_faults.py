@@ -6,6 +6,8 @@ import time
 import pytest
 
 from gimbal.errors import GimbalError, GimbalTimeoutError, ReturnCodeError
+from gimbal.messages import message_packet, motion
+from gimbal.packet import encode_packet
 from gimbal.sim import Faults
 from tests.sim.helpers import wait_until
 
@@ -88,3 +90,14 @@ def test_gimbal_at_rest_after_the_client_stops(make_client, faults: Faults) -> N
     assert wait_until(lambda: not sim.state().moving, 0.7)
     time.sleep(0.1)
     assert not sim.state().moving and time.monotonic() - stopped_at < 1.5
+
+
+def test_a_command_after_one_that_lost_its_final_frame_is_still_answered(sim_host) -> None:
+    """The simulator once fed frames to its framer as a byte stream: a lost one-byte final frame
+    (0xAA) let the broken packet pass its CRC with the next packet's first byte, losing that one."""
+    host, _ = sim_host
+    stop = motion.SpeedControl()
+    broken = next(raw for seq in range(0x10000)
+                  if (raw := encode_packet(message_packet(stop, seq)))[-1] == 0xAA and len(raw) % 8 == 1)
+    host.transport.send(broken[:-1])  # every frame but the last, one-byte one
+    assert isinstance(host.ask(motion.GetAngles()), motion.AnglesReply)
