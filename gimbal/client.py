@@ -5,8 +5,10 @@ rounding to the nearest unit and range-checked by the messages (``RangeError``) 
 is sent.
 
 Replies are matched to requests by SEQ when the gimbal echoes it, otherwise by CmdSet/CmdID
-(latest layout) or to the oldest outstanding request (legacy layout, which has no CmdSet/CmdID);
-once the gimbal has echoed a SEQ, a reply with an unknown SEQ is stale.
+(latest layout) or to the oldest outstanding request (legacy layout, which has no CmdSet/CmdID).
+Once the gimbal has echoed ``ECHO_EVIDENCE`` SEQs in a row, a reply with an unknown SEQ is stale;
+as many replies in a row that could only be paired by command (a gimbal with a fixed SEQ or its
+own counter, which echoed by chance) switch that back.
 A retry resends the *same* packet with the same SEQ, so a late reply to any attempt completes the
 call. Commands whose repetition changes the outcome (relative moves, toggles, camera actions)
 are never retried. Replies that match no outstanding request (``stale_replies``), or are too short
@@ -56,6 +58,7 @@ log = logging.getLogger(__name__)
 
 FIRST_SEQ = 0x1122  # DJI's demo starts here
 RX_POLL_S = 0.05  # how often the receive thread looks at the closing flag
+ECHO_EVIDENCE = 3  # replies in a row that decide whether the gimbal echoes SEQs
 MAX_TIMEOUT = threading.TIMEOUT_MAX  # longer waits overflow the platform's time_t
 ANGLE_KINDS = {"attitude": ANGLES_ATTITUDE, "joint": ANGLES_JOINT}
 FOLLOW_MODES = {"lock": FOLLOW_LOCK, "yaw": FOLLOW_YAW, "fpv": FOLLOW_FPV}
@@ -106,6 +109,10 @@ def speed_message(yaw: float, pitch: float, roll: float = 0.0, *,
 def stop_messages() -> tuple[SpeedControl, SpeedControl]:
     """The safety stop: zero speed still in control, then zero with control released."""
     return SpeedControl(0, 0, 0, SPEED_HOLD), SpeedControl(0, 0, 0, SPEED_RELEASE)
+
+
+def _is_stop(message: Message) -> bool:
+    return message in stop_messages()
 
 
 def lookup(table: dict[str, int], value: str | int, what: str) -> int:
@@ -179,11 +186,14 @@ class GimbalClient:
         self._lock = threading.Lock()
         self._pending: dict[int, PendingReply] = {}
         self._seq = FIRST_SEQ
-        self._seq_echoed = False  # learnt from the first reply that echoes its request's SEQ
+        self._seq_echoed = False  # learnt from ECHO_EVIDENCE replies in a row (see _note_echo)
+        self._echo_run = 0  # > 0: replies in a row that echoed their SEQ; < 0: that did not
         self._closing = threading.Event()
         self._closed = False
         self._rx_error: BaseException | None = None
         self._speed_engaged = False
+        self._tx_lock = threading.Lock()  # a command's checks and its send, against close()
+        self._stops_only = False  # set by close(): other threads' commands must not follow its stop
         self._streamer: SpeedStreamer | None = None
         self._rx_thread = threading.Thread(target=self._receive_loop, name="gimbal-rx", daemon=True)
         self._rx_thread.start()
@@ -199,16 +209,23 @@ class GimbalClient:
         self.close()
 
     def close(self) -> None:
-        """Safety stop, stop the receive thread, shut down the bus if this client built it."""
+        """Safety stop, stop the receive thread, shut down the bus if this client built it.
+        Commands other threads send from the start of the stop on are refused (``GimbalError``),
+        so the stop is the last thing this client sends."""
         if self._closed:
             return
         try:
+            self._stop_streamer()
+            with self._tx_lock:  # a command already past its checks has been sent by now
+                self._stops_only = True
             self.safety_stop()
         finally:
             self._closed = True
             self._closing.set()
-            self._rx_thread.join(timeout=1.0)
+            if threading.current_thread() is not self._rx_thread:  # close() from a push callback
+                self._rx_thread.join(timeout=1.0)
             self._fail_all(GimbalError("client closed"))
+            self.pushes.interrupt(GimbalError("the gimbal client is closed"))
             if self._owns_bus:
                 self.bus.shutdown()
             atexit.unregister(self.close)
@@ -216,11 +233,14 @@ class GimbalClient:
     def safety_stop(self) -> None:
         """Stop the streamer, then send zero speed and release speed control if this client took
         it. Best effort: failures are logged, never raised."""
+        self._stop_streamer()
+        if self._speed_engaged:
+            self.stop_and_release()
+
+    def _stop_streamer(self) -> None:
         streamer = self._streamer
         if streamer is not None:
             streamer.stop()
-        if self._speed_engaged:
-            self.stop_and_release()
 
     def stop_and_release(self) -> None:
         """Zero speed (still in control), then zero with control released (bit 7 clear).
@@ -232,7 +252,8 @@ class GimbalClient:
         for message in stop_messages():
             name = "stop_zero_sent" if message.ctrl_byte & SPEED_TAKE_CONTROL else "stop_release_sent"
             try:
-                if self._rx_error is None and not self._closed:
+                if self._rx_error is None and not self._closed \
+                        and threading.current_thread() is not self._rx_thread:
                     self.request(message, retries=0)
                 else:
                     self.transport.send(self._encode(message)[1])
@@ -270,6 +291,7 @@ class GimbalClient:
             self._rx_error = exc
             log.error("gimbal receive thread stopped: %r", exc)
             self._fail_all(exc)
+            self.pushes.interrupt(BusError(f"the receive thread stopped: {exc}"))
             self._on_bus_lost()
 
     def _on_bus_lost(self) -> None:
@@ -307,24 +329,37 @@ class GimbalClient:
     def _match(self, packet: Packet) -> PendingReply | None:
         """Pop the waiter a reply belongs to.
 
-        By SEQ first. Until the gimbal has been seen echoing SEQs, a reply whose SEQ matches
+        By SEQ first. Unless the gimbal is known to echo SEQs, a reply whose SEQ matches
         nothing goes to the oldest request with its CmdSet/CmdID (latest layout) or to the oldest
-        request (legacy layout); once echoing is seen, such a reply is stale. Raises
+        request (legacy layout); for a gimbal that echoes, such a reply is stale. Raises
         ``PayloadError`` for a reply too short to say which command it answers.
         """
         key = reply_key(packet)
         legacy = key is None
         with self._lock:
             waiter = self._pending.get(packet.seq)
-            if waiter is not None and (legacy or waiter.key == key):
-                self._seq_echoed = True
-            elif self._seq_echoed:
-                waiter = None
-            else:
+            echoed = waiter is not None and (legacy or waiter.key == key)
+            if not echoed:
                 waiter = next((w for w in self._pending.values() if legacy or w.key == key), None)
+            self._note_echo(echoed, waiter is not None)
+            if waiter is not None and not echoed and self._seq_echoed:
+                waiter = None
             if waiter is not None:
                 del self._pending[waiter.seq]
             return waiter
+
+    def _note_echo(self, echoed: bool, by_command: bool) -> None:
+        """Count a reply that echoed its request's SEQ, or one that could only be paired by
+        command; ``ECHO_EVIDENCE`` in a row decide whether the gimbal echoes (one SEQ can match
+        by chance, e.g. a fixed reply SEQ once the client's counter wraps to it)."""
+        if echoed:
+            self._echo_run = max(self._echo_run, 0) + 1
+        elif by_command:
+            self._echo_run = min(self._echo_run, 0) - 1
+        else:
+            return
+        if abs(self._echo_run) >= ECHO_EVIDENCE:
+            self._seq_echoed = self._echo_run > 0
 
     def _fail_all(self, error: BaseException) -> None:
         with self._lock:
@@ -347,13 +382,16 @@ class GimbalClient:
             return seq, raw
 
     def _transmit(self, message: Message, raw: bytes) -> None:
-        self._check_alive()
-        if isinstance(message, SpeedControl) and message.ctrl_byte & SPEED_TAKE_CONTROL:
-            self._speed_engaged = True
-        try:
-            self.transport.send(raw)
-        except can.CanError as exc:
-            raise BusError(f"CAN send failed: {exc}") from exc
+        with self._tx_lock:
+            self._check_alive()
+            if self._stops_only and not _is_stop(message):
+                raise GimbalError("the gimbal client is closing")
+            if isinstance(message, SpeedControl) and message.ctrl_byte & SPEED_TAKE_CONTROL:
+                self._speed_engaged = True
+            try:
+                self.transport.send(raw)
+            except (can.CanError, OSError) as exc:  # third-party interfaces may raise plain OSErrors
+                raise BusError(f"CAN send failed: {exc}") from exc
 
     def submit(self, message: Message, *, cmd_type: int | None = None) -> PendingReply:
         """Send a command that wants a reply and return at once; collect it with ``result``
@@ -399,6 +437,9 @@ class GimbalClient:
         times with the same SEQ, then raises ``GimbalTimeoutError``. ``optional`` sends CmdType
         0x01 (reply optional) and returns None on silence instead of raising.
         """
+        if threading.current_thread() is self._rx_thread:
+            raise GimbalError(f"{message.NAME}: a push callback cannot wait for a reply (it runs on "
+                              "the thread that receives them); hand the work to another thread")
         timeout = self.timeout if timeout is None else timeout
         retries = self.retries if retries is None else retries
         waiter = self.submit(message, cmd_type=REPLY_OPTIONAL if optional else None)
@@ -451,7 +492,8 @@ class GimbalClient:
 
     def on_push(self, cls: type[Message], callback: PushCallback) -> Callable[[], None]:
         """Call ``callback(msg, t)`` (t = ``time.monotonic()`` at arrival) for every ``cls`` push,
-        on the receive thread; exceptions are logged. Returns an unsubscribe function."""
+        on the receive thread; exceptions are logged. Keep it quick: replies wait while it runs,
+        and it cannot make requests (``GimbalError``). Returns an unsubscribe function."""
         return self.pushes.subscribe(cls, callback)
 
     def latest(self, cls: type[Message]) -> tuple[Message, float] | None:
@@ -459,7 +501,8 @@ class GimbalClient:
         return self.pushes.latest(cls)
 
     def wait_for_push(self, cls: type[Message], timeout: float) -> tuple[Message, float]:
-        """The next ``cls`` push; ``GimbalTimeoutError`` after ``timeout`` s."""
+        """The next ``cls`` push; ``GimbalTimeoutError`` after ``timeout`` s, the client's error at
+        once if it is closed or loses the bus meanwhile."""
         self._check_alive()
         return self.pushes.wait(cls, timeout)
 

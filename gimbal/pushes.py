@@ -32,6 +32,7 @@ class PushHub:
         self._latest: dict[type[Message], tuple[Message, float]] = {}
         self._counts: Counter[type[Message]] = Counter()
         self._callbacks: dict[type[Message], list[PushCallback]] = {}
+        self._interrupted: BaseException | None = None
 
     def subscribe(self, cls: type[M], callback: PushCallback[M]) -> Callable[[], None]:
         """Call ``callback(msg, t)`` for every ``cls`` push; returns a function that unsubscribes."""
@@ -66,13 +67,23 @@ class PushHub:
         with self._cond:
             return self._latest.get(cls)  # type: ignore[return-value]
 
+    def interrupt(self, error: BaseException) -> None:
+        """No more pushes will come (the client closed or lost the bus): ``wait`` raises ``error``,
+        now and from then on."""
+        with self._cond:
+            self._interrupted = error
+            self._cond.notify_all()
+
     def wait(self, cls: type[M], timeout: float) -> tuple[M, float]:
-        """The next ``cls`` push to arrive after this call; ``GimbalTimeoutError`` after ``timeout`` s."""
+        """The next ``cls`` push to arrive after this call; ``GimbalTimeoutError`` after ``timeout``
+        s, or the error given to ``interrupt``."""
         _check_push_class(cls)
         deadline = time.monotonic() + timeout
         with self._cond:
             seen = self._counts[cls]
             while self._counts[cls] == seen:
+                if self._interrupted is not None:
+                    raise self._interrupted
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     raise GimbalTimeoutError(f"no {cls.NAME} within {timeout:g} s")

@@ -11,8 +11,8 @@ from typing import Any
 import can
 import pytest
 
-from gimbal.client import Angles, GimbalClient
-from gimbal.errors import BusError, GimbalTimeoutError, RangeError, ReturnCodeError
+from gimbal.client import ECHO_EVIDENCE, Angles, GimbalClient
+from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError, ReturnCodeError
 from gimbal.messages import Message
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
 from gimbal.messages.external import (
@@ -239,7 +239,8 @@ def test_replies_without_the_requests_seq_match_by_command(client: GimbalClient,
 
 def test_late_replies_are_dropped_as_stale(client: GimbalClient, peer: ScriptedPeer) -> None:
     peer.answer(VersionQuery, VersionReply(0, 1, 0x01000000))
-    client.version()  # the gimbal echoes SEQs: later unknown SEQs are stale
+    for _ in range(ECHO_EVIDENCE):  # the gimbal echoes SEQs: later unknown SEQs are stale
+        client.version()
     peer.answer(GetAngles, AnglesReply(0, 1, 111, 0, 0), delay=0.4)
     with pytest.raises(GimbalTimeoutError):
         client.request(GetAngles(), timeout=0.05, retries=0)
@@ -444,4 +445,102 @@ def test_the_zero_push_still_goes_out_once_the_receive_side_is_lost(channel: str
         assert [m.yaw_speed for m in peer.messages(JoystickPush)] == [5000, 0]
         bus.fail_send = True
         gimbal.send_best_effort(JoystickPush())  # logged, not raised
+    bus.shutdown()
+
+
+def test_a_seq_matched_by_chance_does_not_make_the_client_deaf(client: GimbalClient,
+                                                                 peer: ScriptedPeer) -> None:
+    """A gimbal that answers with a fixed SEQ: once the client's counter reached it, one chance
+    match made every later reply stale for good."""
+    peer.answer(VersionQuery, VersionReply(0, 1, 7), seq=0x2000)
+    client._seq = 0x2000 - 2  # the counter about to pass the gimbal's fixed SEQ
+    assert all(client.version().version == 7 for _ in range(6))
+    assert client.stats["stale_replies"] == 0
+
+
+def test_an_echoing_gimbal_is_learnt_and_unlearnt_from_replies_in_a_row(client: GimbalClient,
+                                                                          peer: ScriptedPeer) -> None:
+    peer.answer(VersionQuery, VersionReply(0, 1, 7))
+    for _ in range(ECHO_EVIDENCE):
+        client.version()
+    assert client._seq_echoed
+    peer.answer(VersionQuery, VersionReply(0, 1, 7), seq=0x0001)  # e.g. a firmware update
+    with pytest.raises(GimbalTimeoutError):  # both attempts' replies taken for late ones
+        client.version()
+    assert client.version().version == 7  # the third in a row: paired by command from here on
+    assert not client._seq_echoed and client.stats["stale_replies"] == ECHO_EVIDENCE - 1
+
+
+def test_close_from_another_thread_leaves_the_stop_as_the_last_speed_command(
+        channel: str, peer: ScriptedPeer) -> None:
+    """A thread sending speed() while another closed the client once sent 30 deg/s after the release."""
+    peer.answer(SpeedControl)
+    gimbal = GimbalClient(interface="virtual", channel=channel, timeout=0.2, retries=0)
+    refused: list[BaseException] = []
+
+    def keep_turning() -> None:
+        try:
+            while True:
+                gimbal.speed(30.0, 0.0)
+        except GimbalError as exc:
+            refused.append(exc)
+
+    turner = threading.Thread(target=keep_turning)
+    turner.start()
+    peer.wait_for(SpeedControl, count=5)
+    gimbal.close()
+    turner.join(5.0)
+    assert refused and not turner.is_alive()
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+
+
+def test_close_from_a_push_callback_closes_and_shuts_the_bus_down(channel: str, peer: ScriptedPeer) -> None:
+    gimbal = GimbalClient(interface="virtual", channel=channel)
+    gimbal.on_push(CalibrationStatusPush, lambda message, t: gimbal.close())
+    peer.push(CalibrationStatusPush.of(1, 42))
+    poll(lambda: not gimbal.alive)
+    poll(lambda: gimbal.bus._is_shutdown)
+
+
+def test_a_request_from_a_push_callback_is_refused_at_once(client: GimbalClient, peer: ScriptedPeer) -> None:
+    errors: list[BaseException] = []
+
+    def ask(message: Message, t: float) -> None:
+        try:
+            client.version()
+        except GimbalError as exc:
+            errors.append(exc)
+
+    client.on_push(CalibrationStatusPush, ask)
+    peer.push(CalibrationStatusPush.of(1, 42))
+    poll(lambda: len(errors) == 1)
+    assert "push callback" in str(errors[0]) and not isinstance(errors[0], GimbalTimeoutError)
+
+
+@pytest.mark.parametrize("ending", ["close", "bus lost"])
+def test_wait_for_push_ends_when_the_client_closes_or_loses_the_bus(channel: str, peer: ScriptedPeer,
+                                                                      ending: str) -> None:
+    gimbal = GimbalClient(FlakyBus(channel=channel))
+    end = gimbal.close if ending == "close" else lambda: setattr(gimbal.bus, "fail_recv", True)
+    timer = threading.Timer(0.1, end)
+    timer.start()
+    try:
+        with pytest.raises(GimbalError) as error:
+            gimbal.wait_for_push(CalibrationStatusPush, timeout=30.0)
+        assert not isinstance(error.value, GimbalTimeoutError)
+    finally:
+        timer.join()
+        gimbal.close()
+        gimbal.bus.shutdown()
+
+
+class _OSErrorBus(FlakyBus):
+    def send(self, msg: can.Message, timeout: float | None = None) -> None:
+        raise OSError(105, "No buffer space available")
+
+
+def test_a_plain_oserror_from_a_third_party_bus_is_a_bus_error(channel: str) -> None:
+    bus = _OSErrorBus(channel=channel)
+    with GimbalClient(bus) as gimbal, pytest.raises(BusError, match="No buffer space"):
+        gimbal.version()
     bus.shutdown()
