@@ -164,14 +164,14 @@ class SimulatedGimbal:
         heapq.heappush(self._delayed, (now + self.faults.delay_s, id(packet), packet, name))
         self._wake_if_sooner()
 
-    def _send(self, packet: Packet, name: str, now: float) -> None:
+    def _send(self, packet: Packet, name: str, now: float, stream: str = "replies") -> None:
         if self._injector.silent(now - self._started_at):
             self._discarded["silent_tx"] += 1
             return
         raw = encode_packet(packet)
         frames = [can.Message(arbitration_id=self.config.tx_id, is_extended_id=False, data=data)
                   for i in range(0, len(raw), CAN_FRAME_DATA)
-                  if (data := self._injector.frame(raw[i:i + CAN_FRAME_DATA], "tx")) is not None]
+                  if (data := self._injector.frame(raw[i:i + CAN_FRAME_DATA], stream)) is not None]
         self._sent[name] += 1
         self._bus_send(frames)
 
@@ -186,7 +186,7 @@ class SimulatedGimbal:
 
     def _push(self, message: Message, now: float) -> None:
         self._push_seq = (self._push_seq + 1) & 0xFFFF
-        self._send(message_packet(message, self._push_seq), message.NAME, now)
+        self._send(message_packet(message, self._push_seq), message.NAME, now, "pushes")
 
     # --- tick ---------------------------------------------------------------------------------
 

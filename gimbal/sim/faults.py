@@ -1,5 +1,7 @@
 """Fault injection: lost, corrupted and delayed frames, NACKs, silence, legacy replies, foreign
-traffic. One seeded RNG makes every run reproducible."""
+traffic. Each kind of event draws from its own RNG seeded from ``seed``, so the nth reply's fate
+does not depend on how many pushes or foreign frames the other thread drew before it: the same
+seed and the same commands give the same faults."""
 from __future__ import annotations
 
 import random
@@ -8,6 +10,8 @@ from dataclasses import dataclass
 
 DIRECTIONS = ("both", "rx", "tx")
 FOREIGN_IDS = (0x530, 0x531, 0x426)  # DJI's internal accessory traffic seen on live buses
+#: The RNG streams: frames received, reply frames, push frames, NACKs, legacy replies, foreign traffic.
+STREAMS = ("rx", "replies", "pushes", "nack", "legacy", "foreign")
 
 
 @dataclass(frozen=True)
@@ -46,37 +50,40 @@ class FaultInjector:
     def __init__(self, faults: Faults) -> None:
         self.faults = faults
         self.counts: Counter[str] = Counter()
-        self._rng = random.Random(faults.seed)
+        self._rngs = {name: random.Random(f"{faults.seed}/{name}") for name in STREAMS}
         self._foreign_due = 0.0
 
     def silent(self, elapsed: float) -> bool:
         window = self.faults.silent
         return window is not None and window[0] <= elapsed < window[1]
 
-    def frame(self, data: bytes, direction: str) -> bytes | None:
-        """A frame's data after loss and corruption (None: lost) for ``direction`` rx or tx."""
+    def frame(self, data: bytes, stream: str) -> bytes | None:
+        """A frame's data after loss and corruption (None: lost); ``stream`` is "rx" for a frame
+        received, "replies" or "pushes" for one sent (direction tx)."""
+        direction = "rx" if stream == "rx" else "tx"
         if self.faults.direction not in ("both", direction):
             return data
-        if self.faults.drop and self._rng.random() < self.faults.drop:
+        rng = self._rngs[stream]
+        if self.faults.drop and rng.random() < self.faults.drop:
             self.counts[f"dropped_{direction}"] += 1
             return None
-        if self.faults.corrupt and data and self._rng.random() < self.faults.corrupt:
+        if self.faults.corrupt and data and rng.random() < self.faults.corrupt:
             self.counts[f"corrupted_{direction}"] += 1
-            index = self._rng.randrange(len(data))
+            index = rng.randrange(len(data))
             altered = bytearray(data)
-            altered[index] ^= self._rng.randrange(1, 256)
+            altered[index] ^= rng.randrange(1, 256)
             return bytes(altered)
         return data
 
     def nack(self) -> int | None:
         """The return code to refuse this command with, or None to execute it."""
-        if self.faults.nack and self._rng.random() < self.faults.nack:
+        if self.faults.nack and self._rngs["nack"].random() < self.faults.nack:
             self.counts["nacks"] += 1
             return self.faults.nack_code
         return None
 
     def legacy_reply(self) -> bool:
-        if self.faults.legacy and self._rng.random() < self.faults.legacy:
+        if self.faults.legacy and self._rngs["legacy"].random() < self.faults.legacy:
             self.counts["legacy_replies"] += 1
             return True
         return False
@@ -86,11 +93,12 @@ class FaultInjector:
         pieces and random bytes, on DJI's accessory ids."""
         self._foreign_due += self.faults.foreign_rate * dt
         count, self._foreign_due = int(self._foreign_due), self._foreign_due % 1.0
+        rng = self._rngs["foreign"]
         frames = []
         for _ in range(count):
-            data = bytearray(self._rng.randbytes(self._rng.randint(1, 8)))
-            if self._rng.random() < 0.5:
+            data = bytearray(rng.randbytes(rng.randint(1, 8)))
+            if rng.random() < 0.5:
                 data[0] = 0x55
-            frames.append((self._rng.choice(FOREIGN_IDS), bytes(data)))
+            frames.append((rng.choice(FOREIGN_IDS), bytes(data)))
         self.counts["foreign_sent"] += len(frames)
         return frames

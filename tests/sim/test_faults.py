@@ -7,6 +7,7 @@ import pytest
 
 from gimbal.errors import GimbalError, GimbalTimeoutError, ReturnCodeError
 from gimbal.messages import message_packet, motion
+from gimbal.messages.telemetry import PUSH_ENABLE, PushControl
 from gimbal.packet import encode_packet
 from gimbal.sim import Faults
 from tests.sim.helpers import wait_until
@@ -101,3 +102,21 @@ def test_a_command_after_one_that_lost_its_final_frame_is_still_answered(sim_hos
                   if (raw := encode_packet(message_packet(stop, seq)))[-1] == 0xAA and len(raw) % 8 == 1)
     host.transport.send(broken[:-1])  # every frame but the last, one-byte one
     assert isinstance(host.ask(motion.GetAngles()), motion.AnglesReply)
+
+
+def test_the_same_seed_loses_the_same_replies_whatever_the_pushes_draw(make_client) -> None:
+    """The pushes (tick thread) once drew from the replies' RNG, so a seed did not repeat a run."""
+    def outcomes() -> str:
+        client, _ = make_client(faults=Faults(drop=0.2, direction="tx", seed=7), timeout=0.25, retries=0)
+        client.request(PushControl(PUSH_ENABLE), retries=20)
+        marks = ""
+        for _ in range(20):
+            try:
+                client.get_angles()
+                marks += "."
+            except GimbalTimeoutError:
+                marks += "x"
+        return marks
+
+    first = outcomes()
+    assert "x" in first and "." in first and outcomes() == first
