@@ -62,6 +62,8 @@ class TrackOptions:
     attitude_feedback: str = "auto"
     yaw_sign: int = 1  # -1 for a gimbal whose positive yaw speed turns the other way (seen on an RS 5)
     pitch_sign: int = 1
+    yaw_attitude_sign: int = 1  # -1 for a gimbal that reports its yaw with the opposite sign
+    pitch_attitude_sign: int = 1
     max_frames: int | None = None
     video: bool = True
     video_width: int | None = DEFAULT_VIDEO_WIDTH  # None: the source's own size
@@ -91,6 +93,13 @@ def control_config(max_speed_dps: float | None) -> ControlConfig:
         return base
     return dataclasses.replace(base, max_speed_dps=max_speed_dps,
                                max_accel_dps2=max(base.max_accel_dps2, max_speed_dps / base.ramp_s))
+
+
+def signed_attitude(yaw: float, pitch: float, options: TrackOptions) -> tuple[float, float]:
+    """A reported yaw/pitch in this project's convention (yaw positive to the right, pitch up).
+    Independent of the speed signs: a gimbal that turns the other way for a positive speed
+    command (``yaw_sign``) may still report its angles the usual way, as one RS 5 does."""
+    return yaw * options.yaw_attitude_sign, pitch * options.pitch_attitude_sign
 
 
 class TrackSession:
@@ -216,7 +225,7 @@ class TrackSession:
         sample = self.history.at(stamp)
         if sample is None:
             return None
-        return sample.yaw * self.options.yaw_sign, sample.pitch * self.options.pitch_sign
+        return signed_attitude(sample.yaw, sample.pitch, self.options)
 
     def _write_frame(self, frame: Frame, stamp: float, state: str, estimate: TargetEstimate | None,
                      command: Any) -> None:

@@ -11,6 +11,7 @@ from types import FrameType
 
 import can
 
+from gimbal.messages.motion import AXES
 from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
 from gimbal.sim.faults import DIRECTIONS
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, open_can_bus
@@ -41,6 +42,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     model.add_argument("--calibration-time", type=float, default=SimConfig.calibration_s, metavar="S",
                        help="auto-calibration duration (default %(default)s)")
     model.add_argument("--no-camera", action="store_true", help="no camera: camera commands fail (0x02)")
+    model.add_argument("--flip", type=_axes, default=(), metavar="AXES",
+                       help="axes (yaw,roll,pitch, comma separated) that turn the opposite way to a speed "
+                       "command, while their angles keep their sign (one RS 5 does this for yaw)")
     faults = parser.add_argument_group("faults")
     faults.add_argument("--drop", type=float, default=0.0, metavar="FRACTION", help="lose CAN frames")
     faults.add_argument("--corrupt", type=float, default=0.0, metavar="FRACTION",
@@ -81,6 +85,13 @@ def _version(text: str) -> int:
     raise argparse.ArgumentTypeError(f"not a version AA.BB.CC.DD or 32-bit integer: {text!r}")
 
 
+def _axes(text: str) -> tuple[str, ...]:
+    axes = tuple(a.strip() for a in text.split(",") if a.strip())
+    if not axes or any(a not in AXES for a in axes):
+        raise argparse.ArgumentTypeError(f"not a comma-separated list of {', '.join(AXES)}: {text!r}")
+    return axes
+
+
 def _window(text: str) -> tuple[float, float]:
     start, sep, end = text.partition(":")
     try:
@@ -98,7 +109,8 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
         config = SimConfig(rx_id=args.tx_id, tx_id=args.rx_id, legacy=args.legacy,
                            push_rate_hz=args.push_rate, accel_dps2=args.accel, base_yaw_deg=args.base_yaw,
                            yaw_continuous=args.yaw_continuous, version=args.version,
-                           calibration_s=args.calibration_time, camera_connected=not args.no_camera)
+                           calibration_s=args.calibration_time, camera_connected=not args.no_camera,
+                           speed_signs=tuple(-1 if a in args.flip else 1 for a in AXES))
         faults = Faults(drop=args.drop, corrupt=args.corrupt, direction=args.fault_direction,
                         delay_s=args.delay_ms / 1000.0, nack=args.nack, nack_code=args.nack_code,
                         silent=args.silent, legacy=args.legacy_fraction, foreign_rate=args.foreign_rate,

@@ -73,9 +73,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="use the gimbal attitude (camera on the gimbal); default auto: for live "
                          "sources only")
     control.add_argument("--invert-yaw", action="store_true",
-                         help="this gimbal turns the other way for positive yaw (check on hardware)")
+                         help="this gimbal turns the other way for a positive yaw speed (check on hardware)")
     control.add_argument("--invert-pitch", action="store_true",
-                         help="this gimbal turns the other way for positive pitch")
+                         help="this gimbal turns the other way for a positive pitch speed")
+    control.add_argument("--invert-yaw-attitude", action="store_true",
+                         help="this gimbal reports its yaw with the opposite sign (with --attitude-feedback; "
+                         "a gimbal mirrored in both needs both flags)")
+    control.add_argument("--invert-pitch-attitude", action="store_true",
+                         help="this gimbal reports its pitch with the opposite sign")
     run = parser.add_argument_group("run")
     run.add_argument("--realtime", action="store_true", help="play files at their own frame rate")
     run.add_argument("--fps", type=float, help="frame rate of an image folder (default: 30), or a video file's "
@@ -119,6 +124,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         hfov_deg=args.hfov, rate_hz=args.rate, max_speed_dps=args.max_speed, record=args.record,
         realtime=args.realtime, attitude_feedback=args.attitude_feedback,
         yaw_sign=-1 if args.invert_yaw else 1, pitch_sign=-1 if args.invert_pitch else 1,
+        yaw_attitude_sign=-1 if args.invert_yaw_attitude else 1,
+        pitch_attitude_sign=-1 if args.invert_pitch_attitude else 1,
         max_frames=args.max_frames, video=not args.no_video, video_width=args.video_width or None,
         progress=not args.quiet)
 

@@ -13,8 +13,10 @@ import numpy as np
 import pytest
 
 from gimbal.messages.camera import CameraActionCode
+from pipelines.cli import build_parser, track_cmd
 from pipelines.control import ControlConfig
 from pipelines.outputs.telemetry import read_telemetry
+from pipelines.track_session import signed_attitude
 from tests.track.helpers import (DEMO, DEMO_ROI, SIZE, assert_stopped_at_end, decoded,
                                  host_commands, in_speed_range, make_clip, roi_at, run_track,
                                  speed_commands)
@@ -216,3 +218,12 @@ def test_a_roi_over_the_frame_edge_is_tracked_as_given(tmp_path: Path,
     assert run_track(DEMO, out, "--roi=-20,152,64,96", "--max-frames", "3", "--no-video") == 0
     assert "note" not in capsys.readouterr().err
     assert read_telemetry(out / "telemetry.jsonl")[0]["box"] == [-20, 152, 64, 96]
+
+
+def test_speed_and_attitude_signs_are_inverted_separately() -> None:
+    """--invert-yaw once flipped the attitude read too: on a gimbal that turns the other way but
+    reports its angles the usual way (one RS 5), the filter saw the subject move the wrong way."""
+    args = build_parser().parse_args(["track", "clip.mp4", "--invert-yaw", "--invert-pitch-attitude"])
+    options = track_cmd._options(args)
+    assert (options.yaw_sign, options.pitch_sign) == (-1, 1)
+    assert signed_attitude(10.0, 5.0, options) == (10.0, -5.0)
