@@ -6,9 +6,9 @@ is sent.
 
 Replies are matched to requests by SEQ when the gimbal echoes it, otherwise by CmdSet/CmdID
 (latest layout) or to the oldest outstanding request (legacy layout, which has no CmdSet/CmdID).
-Once the gimbal has echoed ``ECHO_EVIDENCE`` SEQs in a row, a reply with an unknown SEQ is stale;
-as many replies in a row that could only be paired by command (a gimbal with a fixed SEQ or its
-own counter, which echoed by chance) switch that back.
+Once the gimbal has echoed a SEQ, a reply with an unknown SEQ is stale; ``ECHO_EVIDENCE`` replies
+in a row that could only be paired by command (a gimbal with a fixed SEQ or its own counter, one
+of which matched by chance) switch that back.
 A retry resends the *same* packet with the same SEQ, so a late reply to any attempt completes the
 call. Commands whose repetition changes the outcome (relative moves, toggles, camera actions)
 are never retried. Replies that match no outstanding request (``stale_replies``), or are too short
@@ -58,7 +58,7 @@ log = logging.getLogger(__name__)
 
 FIRST_SEQ = 0x1122  # DJI's demo starts here
 RX_POLL_S = 0.05  # how often the receive thread looks at the closing flag
-ECHO_EVIDENCE = 3  # replies in a row that decide whether the gimbal echoes SEQs
+ECHO_EVIDENCE = 3  # replies in a row paired only by command that show the gimbal does not echo SEQs
 MAX_TIMEOUT = threading.TIMEOUT_MAX  # longer waits overflow the platform's time_t
 ANGLE_KINDS = {"attitude": ANGLES_ATTITUDE, "joint": ANGLES_JOINT}
 FOLLOW_MODES = {"lock": FOLLOW_LOCK, "yaw": FOLLOW_YAW, "fpv": FOLLOW_FPV}
@@ -186,8 +186,8 @@ class GimbalClient:
         self._lock = threading.Lock()
         self._pending: dict[int, PendingReply] = {}
         self._seq = FIRST_SEQ
-        self._seq_echoed = False  # learnt from ECHO_EVIDENCE replies in a row (see _note_echo)
-        self._echo_run = 0  # > 0: replies in a row that echoed their SEQ; < 0: that did not
+        self._seq_echoed = False  # learnt from a reply that echoes its request's SEQ (see _note_echo)
+        self._unechoed_run = 0  # replies in a row since then that could only be paired by command
         self._closing = threading.Event()
         self._closed = False
         self._rx_error: BaseException | None = None
@@ -349,17 +349,15 @@ class GimbalClient:
             return waiter
 
     def _note_echo(self, echoed: bool, by_command: bool) -> None:
-        """Count a reply that echoed its request's SEQ, or one that could only be paired by
-        command; ``ECHO_EVIDENCE`` in a row decide whether the gimbal echoes (one SEQ can match
-        by chance, e.g. a fixed reply SEQ once the client's counter wraps to it)."""
+        """A reply that echoed its request's SEQ shows the gimbal echoes; ``ECHO_EVIDENCE`` in a
+        row that could only be paired by command show that was chance (a fixed reply SEQ once
+        the client's counter wraps to it), and they are paired by command again."""
         if echoed:
-            self._echo_run = max(self._echo_run, 0) + 1
+            self._seq_echoed, self._unechoed_run = True, 0
         elif by_command:
-            self._echo_run = min(self._echo_run, 0) - 1
-        else:
-            return
-        if abs(self._echo_run) >= ECHO_EVIDENCE:
-            self._seq_echoed = self._echo_run > 0
+            self._unechoed_run += 1
+            if self._unechoed_run >= ECHO_EVIDENCE:
+                self._seq_echoed = False
 
     def _fail_all(self, error: BaseException) -> None:
         with self._lock:
