@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 
 from tracker.boxes import Box, center, clip_to_frame, from_center
-from tracker.features import to_grey
+from tracker.frames import as_grey
 
 TEMPLATE_PX = 32
 
@@ -52,7 +52,7 @@ class AppearanceModel:
         crop = frame[ry:ry + rh, rx:rx + rw]
         scaled = cv2.resize(crop, (max(TEMPLATE_PX, int(round(rw * sx))), max(TEMPLATE_PX, int(round(rh * sy)))),
                             interpolation=cv2.INTER_AREA)
-        grey = to_grey(scaled).astype(np.float32)
+        grey = as_grey(scaled).astype(np.float32)
         best = Match(around, 0.0)
         for template in (self.anchor, self.recent):
             scores = cv2.matchTemplate(grey, template, cv2.TM_CCOEFF_NORMED)
@@ -67,7 +67,7 @@ def cut_patch(frame: np.ndarray, box: Box) -> np.ndarray:
     x, y, w, h = box
     w, h = max(w, 2.0), max(h, 2.0)
     crop = cv2.getRectSubPix(frame, (int(round(w)), int(round(h))), (x + w / 2.0, y + h / 2.0))
-    return to_grey(cv2.resize(crop, (TEMPLATE_PX, TEMPLATE_PX), interpolation=cv2.INTER_AREA)).astype(np.float32)
+    return as_grey(cv2.resize(crop, (TEMPLATE_PX, TEMPLATE_PX), interpolation=cv2.INTER_AREA)).astype(np.float32)
 
 
 def _ncc(a: np.ndarray, b: np.ndarray) -> float:

@@ -10,6 +10,7 @@ import numpy as np
 
 from tracker.boxes import Box, cut_to_frame
 from tracker.dcf import DcfBackend
+from tracker.frames import as_bgr, as_bgr_or_grey
 from tracker.nanotrack import NanoTrackBackend, load_nanotrack_networks, nanotrack_model_files
 
 
@@ -23,6 +24,22 @@ class TrackingBackend(Protocol):
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
         """The new box (``None`` when the backend gives up) and its own score in 0..1."""
+
+
+class ConvertingBackend:
+    """A backend handed every frame in a format it takes, whatever the caller's: grey (H x W or
+    H x W x 1), BGR or BGRA ``uint8``. BGR frames pass as they are."""
+
+    def __init__(self, backend: TrackingBackend, convert: Callable[[np.ndarray], np.ndarray]) -> None:
+        self.name = backend.name
+        self._backend = backend
+        self._convert = convert
+
+    def init(self, frame: np.ndarray, box: Box) -> None:
+        self._backend.init(self._convert(frame), box)
+
+    def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
+        return self._backend.update(self._convert(frame))
 
 
 class OpenCvBackend:
@@ -83,10 +100,18 @@ def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
 
 
 BACKEND_NAMES = ("dcf", "nanotrack", "csrt-fast", "csrt", "kcf", "mil", "mosse", "nano")
+# OpenCV's KCF and Nano fail on grey frames; the others take grey as it is (cheaper than three channels).
+NEEDS_BGR = ("kcf", "nano")
 
 
 def make_backend(name: str, model_dir: str | Path | None = None) -> TrackingBackend:
-    """A fresh backend by name (one of ``BACKEND_NAMES``); ``nanotrack`` and ``nano`` need ``model_dir``."""
+    """A fresh backend by name (one of ``BACKEND_NAMES``) taking grey, BGR and BGRA frames;
+    ``nanotrack`` and ``nano`` need ``model_dir``."""
+    return ConvertingBackend(_bare_backend(name, model_dir), as_bgr if name in NEEDS_BGR else as_bgr_or_grey)
+
+
+def _bare_backend(name: str, model_dir: str | Path | None) -> TrackingBackend:
+    """The backend by name, taking frames in whichever formats it takes itself."""
     if name == "dcf":
         return DcfBackend()
     if name == "nanotrack":

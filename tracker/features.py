@@ -12,6 +12,8 @@ import functools
 import cv2
 import numpy as np
 
+from tracker.frames import as_grey
+
 CELL = 4
 SIGNED_BINS = 18
 CHANNELS = SIGNED_BINS + SIGNED_BINS // 2 + 1
@@ -50,14 +52,9 @@ def cell_features(grey: np.ndarray) -> np.ndarray:
                            grey_level], axis=3).astype(np.float32)
 
 
-def to_grey(image: np.ndarray) -> np.ndarray:
-    """A BGR image in grey (a grey image as it is)."""
-    return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
-
-
 def unit_grey(image: np.ndarray) -> np.ndarray:
     """A BGR or grey ``uint8`` image as grey float32 in 0..1, as ``cell_features`` takes it."""
-    return to_grey(image).astype(np.float32) * (1.0 / 255.0)
+    return as_grey(image).astype(np.float32) * (1.0 / 255.0)
 
 
 def _neighbourhood_sum(energy: np.ndarray) -> np.ndarray:

@@ -9,6 +9,7 @@ import numpy as np
 from tracker.appearance import AppearanceModel, Match, cut_patch
 from tracker.backends import TrackingBackend
 from tracker.boxes import Box, start_box
+from tracker.frames import as_bgr_or_grey
 from tracker.detectors import Detector
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.kalman import BoxKalman
@@ -55,7 +56,8 @@ class SubjectTracker:
 
     def init(self, frame: np.ndarray, box: Box, timestamp: float) -> TargetEstimate:
         """Start following ``box`` (x, y, w, h) in ``frame``; it may reach over the frame's edges
-        (``ValueError`` when it misses the frame)."""
+        (``ValueError`` when it misses the frame). Frames may be grey, BGR or BGRA."""
+        frame = as_bgr_or_grey(frame)
         height, width = frame.shape[:2]
         box = start_box(tuple(float(v) for v in box), width, height)
         self._appearance = AppearanceModel(frame, box)
@@ -67,6 +69,7 @@ class SubjectTracker:
         """Follow the subject into ``frame`` captured at ``timestamp`` (seconds)."""
         if self._appearance is None:
             raise RuntimeError("SubjectTracker.update() before init()")
+        frame = as_bgr_or_grey(frame)
         self._frame_index += 1
         s = self.settings
         predicted = self._kalman.predict(timestamp)

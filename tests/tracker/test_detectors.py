@@ -2,6 +2,7 @@
 import subprocess
 import sys
 
+import cv2
 import numpy as np
 import pytest
 
@@ -23,6 +24,89 @@ def test_motion_ignores_a_static_scene():
     frame = render_sequence(frames=1, seed=9).frames[0]
     detector = make_detector("motion")
     assert [detector.detect(frame.copy()) for _ in range(4)] == [[], [], [], []]
+
+
+def _moving_square(look: np.ndarray, frames: int, still: int = 0, noise: float = 0.0, step: int = 10, x0: int = 60,
+                   seed: int = 0) -> tuple[list[np.ndarray], list[tuple[int, int, int, int] | None]]:
+    """A static textured scene for ``still`` frames, then ``look`` (a square) moving ``step`` px a frame to
+    the right from ``x0``; its boxes (None while it is not there). ``noise``: sensor noise's sigma in grey levels."""
+    rng = np.random.default_rng(seed)
+    background = texture(240, 320, rng, cell=16, contrast=0.35)
+    size = look.shape[0]
+    images, boxes = [background.copy() for _ in range(still)], [None] * still
+    for i in range(frames):
+        image = background.copy()
+        x = x0 + step * i
+        image[100:100 + size, x:x + size] = look
+        images.append(image)
+        boxes.append((x, 100, size, size))
+    if noise:
+        images = [np.clip(f + rng.normal(0.0, noise, f.shape), 0, 255).astype(np.uint8) for f in images]
+    return images, boxes
+
+
+def _boxes(frames: list[np.ndarray]) -> list[list[tuple[float, ...]]]:
+    """The motion detector's boxes in each frame, largest first."""
+    detector = make_detector("motion")
+    return [[d.box for d in detector.detect(f)] for f in frames]
+
+
+def _first_boxes(frames: list[np.ndarray]) -> list[tuple[float, ...] | None]:
+    return [found[0] if found else None for found in _boxes(frames)]
+
+
+def _close(found, truth, tolerance: float = 3.0) -> bool:
+    return found is not None and max(abs(a - b) for a, b in zip(found, truth)) <= tolerance
+
+
+TEXTURED = texture(40, 40, np.random.default_rng(1), cell=6, contrast=1.0)
+FLAT = np.full((40, 40, 3), 235, np.uint8)
+
+
+@pytest.mark.parametrize("look", [TEXTURED, FLAT], ids=["textured", "flat"])
+def test_motion_boxes_an_object_where_it_is_now(look):
+    """A 40 px square moving 10 px a frame into a watched scene: its box, not the ground it left
+    (52 px wide, textured) nor two edge strips, the first the trailing one (flat-coloured)."""
+    frames, truth = _moving_square(look, frames=8, still=5, noise=2.0)
+    found = _first_boxes(frames)
+    assert all(_close(f, t) for f, t in zip(found[7:], truth[7:])), list(zip(found[7:], truth[7:]))
+
+
+def test_motion_boxes_an_object_moving_from_the_first_frame_where_it_is_once_it_has_left_its_start():
+    seq = render_sequence(frames=20, speed=6.0, seed=8)
+    found = _first_boxes(seq.frames)
+    ious = [iou(f, t) if f else 0.0 for f, t in zip(found[10:], seq.boxes[10:])]
+    assert min(ious) > 0.85, ious  # three-frame differencing alone: 0.76-0.83
+
+
+def test_motion_forgets_where_a_still_subject_stood_once_it_walks_off():
+    """Learnt as background while it stood: once clear of that spot, the spot is not reported."""
+    still, _ = _moving_square(TEXTURED, frames=4, step=0)
+    walk, truth = _moving_square(TEXTURED, frames=10, step=10)
+    found = _boxes(still + walk)[4:]
+    assert all(len(f) == 1 and _close(f[0], t) for f, t in zip(found[6:], truth[6:])), list(zip(found[6:], truth[6:]))
+
+
+def test_motion_starts_afresh_after_a_change_over_the_whole_picture():
+    """Light switched on (or the camera moved): the background is learnt again from the next three frames,
+    instead of over ``settle_frames`` with the whole picture one blob meanwhile."""
+    frames, truth = _moving_square(TEXTURED, frames=6, still=14)  # brighter from frame 8, the square from 14
+    found = _first_boxes(frames[:8] + [cv2.add(f, 40) for f in frames[8:]])
+    assert all(f is None for f in found[9:14])
+    assert all(_close(f, t) for f, t in zip(found[16:], truth[16:])), list(zip(found[16:], truth[16:]))
+
+
+def test_motion_ignores_sensor_noise():
+    frames, _ = _moving_square(TEXTURED, frames=40, step=0, noise=4.0)
+    assert _first_boxes(frames) == [None] * 40
+
+
+def test_motion_restarts_when_the_frame_size_changes():
+    frames = render_sequence(frames=8, speed=6.0, seed=8).frames
+    small = render_sequence(frames=8, frame_size=(160, 120), speed=3.0, seed=8).frames
+    detector = make_detector("motion")
+    found = [detector.detect(f) for f in frames[:4] + small]
+    assert found[4] == found[5] == [] and all(found[6:])  # three frames of the new size, then it reports
 
 
 def test_motion_reports_the_largest_moving_thing_first():
