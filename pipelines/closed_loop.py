@@ -4,7 +4,9 @@
 Runs in real time (the client's keep-alive and the simulator run on the wall clock). Each frame
 is captured (rendered at the simulator's true attitude), handed to the tracker ``latency_s``
 later, and the setpoint goes out through the ``SpeedStreamer``; the ground truth in the view
-gives the centring error of every frame.
+gives the centring error of every frame that has one. A frame without ground truth (a NaN box,
+or width or height not above 0, as ``tracker.metrics.has_truth``) is left out of the scores and
+is no detection for the oracle; the tracker sees its rendered view as any other.
 """
 from __future__ import annotations
 
@@ -25,8 +27,10 @@ from pipelines.control.metrics import CentringSample, summarize
 from pipelines.virtual_camera import VirtualCamera
 from tracker import make_tracker
 from tracker.boxes import Box, center
-from tracker.datasets import load_sequence
+from tracker.datasets import Sequence, load_sequence
 from tracker.estimate import TargetEstimate, TrackState
+from tracker.evaluation import first_box
+from tracker.metrics import has_truth
 
 ORACLE = "oracle"
 
@@ -45,9 +49,11 @@ class LoopSettings:
 
 @dataclass(frozen=True)
 class LoopStep:
-    """One frame: its centring sample (at capture) and the setpoint it produced."""
+    """One frame: its capture time (from the start), centring sample (``None`` without ground
+    truth) and the setpoint it produced."""
 
-    sample: CentringSample
+    t: float
+    sample: CentringSample | None
     command: RateCommand
 
 
@@ -81,7 +87,7 @@ class _Captured:
     index: int
     view: np.ndarray
     box: Box | None
-    sample: CentringSample
+    sample: CentringSample | None
 
 
 def _sleep_until(t: float) -> None:
@@ -90,11 +96,29 @@ def _sleep_until(t: float) -> None:
         time.sleep(delay)
 
 
+def _truth_in_view(vc: VirtualCamera, source_box: Box, yaw: float, pitch: float,
+                   t: float) -> tuple[Box | None, CentringSample | None]:
+    """The ground-truth box in the view (``None`` if behind it) and the frame's centring sample at
+    ``t``; both ``None`` for a frame without ground truth."""
+    if not has_truth(source_box):
+        return None, None
+    return (vc.box_to_view(source_box, yaw, pitch),
+            CentringSample(t, *vc.center_offset(source_box, yaw, pitch)))
+
+
+def _check_truth(seq: Sequence, tracked: bool) -> None:
+    """ValueError when no frame has ground truth, or a ``tracked`` run's first frame has none (the
+    tracker starts on it)."""
+    if seq.groundtruth is None or not any(has_truth(box) for box in seq.groundtruth):
+        raise ValueError(f"{seq.name}: no ground truth, cannot measure centring")
+    if tracked:
+        first_box(seq)
+
+
 def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> LoopResult:
     """Run ``sequence`` (a folder or video with ground truth) through the loop; see the module doc."""
     seq = load_sequence(sequence)
-    if seq.groundtruth is None:
-        raise ValueError(f"{sequence}: no ground truth, cannot measure centring")
+    _check_truth(seq, tracked=settings.tracker != ORACLE)
     frames: Iterator[np.ndarray] = seq.frames()
     first = next(frames)
     vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
@@ -126,7 +150,7 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
                 now = time.monotonic()
                 cmd = controller.update(est, None if att is None else (att.yaw, att.pitch), now)
                 streamer.set(cmd.yaw_dps, cmd.pitch_dps, stamp=item.t)
-                steps.append(LoopStep(item.sample, cmd))
+                steps.append(LoopStep(item.t - t0, item.sample, cmd))
 
             frame: np.ndarray | None = first
             index = 0
@@ -139,11 +163,9 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
                 _sleep_until(t_next)
                 t_cap = time.monotonic()
                 yaw, _, pitch = sim.state().attitude
-                source_box = next(truth)
                 view = vc.render(frame, yaw, pitch)
-                box = vc.box_to_view(source_box, yaw, pitch)
-                pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box,
-                                         CentringSample(t_cap - t0, *vc.center_offset(source_box, yaw, pitch))))
+                box, sample = _truth_in_view(vc, next(truth), yaw, pitch, t_cap - t0)
+                pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box, sample))
                 index += 1
                 frame = next(frames, None)
             streamer.stop()

@@ -7,18 +7,32 @@ recorded frame map into the view the same way, so the centring error is known ev
 """
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
 
 from pipelines.control.camera import CameraModel
 from pipelines.control.direction import rotation_matrix
+from pipelines.control.metrics import MAX_ERROR
 from tracker.boxes import Box, center
 
 # (forward, right, up) -> OpenCV camera axes (x right, y down, z forward)
 _TO_CV = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
 
+
 def _intrinsics(cam: CameraModel) -> np.ndarray:
     return np.array([[cam.focal_px, 0.0, cam.cx], [0.0, cam.focal_px, cam.cy], [0.0, 0.0, 1.0]])
+
+
+def _capped(dx: float, dy: float, behind: bool) -> tuple[float, float]:
+    """The offset shortened to at most ``MAX_ERROR``; ``behind``: stretched to it (an offset of
+    infinite length in that direction; straight behind counts as right)."""
+    length = math.hypot(dx, dy)
+    if length == 0.0:
+        return (MAX_ERROR, 0.0) if behind else (0.0, 0.0)
+    scale = MAX_ERROR / length if behind else min(1.0, MAX_ERROR / length)
+    return dx * scale, dy * scale
 
 
 class VirtualCamera:
@@ -60,10 +74,15 @@ class VirtualCamera:
                                    flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
                                    borderMode=cv2.BORDER_CONSTANT)
 
+    def _homogeneous(self, points: np.ndarray, yaw: float, pitch: float) -> np.ndarray:
+        """Source pixels (N x 2) -> homogeneous view pixels (N x 3), the third value above 0 in
+        front of the view: ``K_view`` times the view ray of each point."""
+        _, h = self._homographies(yaw, pitch)
+        return np.c_[np.asarray(points, float).reshape(-1, 2), np.ones(len(points))] @ h.T
+
     def to_view(self, points: np.ndarray, yaw: float, pitch: float) -> np.ndarray:
         """Source pixels (N x 2) -> view pixels (N x 2); NaN for points behind the view."""
-        _, h = self._homographies(yaw, pitch)
-        p = np.c_[np.asarray(points, float).reshape(-1, 2), np.ones(len(points))] @ h.T
+        p = self._homogeneous(points, yaw, pitch)
         out = p[:, :2] / p[:, 2:3]
         out[p[:, 2] <= 0] = np.nan
         return out
@@ -79,14 +98,22 @@ class VirtualCamera:
 
     def center_offset(self, box: Box, yaw: float, pitch: float) -> tuple[float, float, bool]:
         """Signed offset (dx, dy) of the box centre from the view centre as fractions of the view
-        diagonal (right, down positive), and whether the centre lies inside the view; a centre
-        behind the view is (1, 0) and outside."""
-        (cx, cy), = self.to_view(np.array([center(box)]), yaw, pitch)
+        diagonal (right, down positive), and whether the centre lies inside the view.
+
+        The offset is at most ``MAX_ERROR`` long: a centre further out keeps its direction, and one
+        behind the view is ``MAX_ERROR`` towards it. A box without a finite centre is a ValueError.
+        """
+        point = np.array([center(box)], float)
+        if not np.isfinite(point).all():
+            raise ValueError(f"box {box} has no finite centre")
+        (x, y, z), = self._homogeneous(point, yaw, pitch).tolist()
         cam = self.camera
-        if np.isnan(cx):
-            return 1.0, 0.0, False
+        if z <= 0:
+            return *_capped(x - cam.cx * z, y - cam.cy * z, behind=True), False
+        cx, cy = x / z, y / z
         inside = 0.0 <= cx < cam.width and 0.0 <= cy < cam.height
-        return (cx - cam.cx) / cam.diagonal_px, (cy - cam.cy) / cam.diagonal_px, inside
+        dx, dy = _capped((cx - cam.cx) / cam.diagonal_px, (cy - cam.cy) / cam.diagonal_px, behind=False)
+        return dx, dy, inside
 
     def center_error(self, box: Box, yaw: float, pitch: float) -> tuple[float, bool]:
         """Distance from the box centre to the view centre as a fraction of the view diagonal,

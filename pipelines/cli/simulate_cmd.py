@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
 from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, run_closed_loop
 from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
 from pipelines.control.controller import controller_names
+from pipelines.control.metrics import MAX_ERROR, OVERSHOOT_WINDOW_S
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
 from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers
@@ -23,7 +25,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "simulate", help="run tracker + control + client against the simulated gimbal on a sequence",
         description="Play SEQ_DIR (frames or a video with ground truth) through a narrower virtual "
         "camera mounted on the simulated gimbal (python-can virtual bus, simulator in-process), in "
-        "real time, and report how well the subject stays centred.",
+        "real time, and report how well the subject stays centred. Frames without ground truth "
+        "(NaN or empty boxes) are left out of the scores and are no detection for --tracker oracle.",
         epilog="examples:\n  gimbaltrack simulate ../shared/data/sequences/vot15_ball1\n"
         "  gimbaltrack simulate ../shared/data/sequences/vot15_ball1 --tracker oracle --latency 100 --out /tmp/sim\n"
         "  gimbaltrack simulate samples/demo.mp4 --controller p --json",
@@ -76,10 +79,10 @@ def summary_of(result: LoopResult) -> dict[str, object]:
 
 def write_plot(path: Path, result: LoopResult) -> None:
     from pipelines.outputs.plot import write_timeseries_png
-    t = [step.sample.t for step in result.steps]
+    t = [step.t for step in result.steps]
     write_timeseries_png(
         path, t,
-        [{"centre error": [step.sample.error for step in result.steps]},
+        [{"centre error": [math.nan if step.sample is None else step.sample.error for step in result.steps]},
          {"yaw": [step.command.yaw_dps for step in result.steps],
           "pitch": [step.command.pitch_dps for step in result.steps]}],
         titles=[f"centring error ({result.settings.controller}, +{result.settings.latency_s * 1000:.0f} ms)",
@@ -115,14 +118,15 @@ def run(args: argparse.Namespace) -> int:
         return 0
     ttc = summary["time_to_first_centre"]
     used = result.settings  # the tracker's resolved name, the view's field of view
-    print(f"{result.summary['frames']} frames, controller {used.controller}, tracker {used.tracker}, "
+    print(f"{summary['frames']} frames ({summary['frames_scored']} with ground truth, scored), "
+          f"controller {used.controller}, tracker {used.tracker}, "
           f"view {args.size[0]}x{args.size[1]} at {used.hfov_deg:.1f} deg, "
           f"+{args.latency:g} ms latency (capture to bus, median {summary['median_capture_to_bus_ms']:.0f} ms)")
-    print(f"centring error (fraction of diagonal): mean {summary['mean_center_error']:.4f}, "
-          f"RMS {summary['rms_center_error']:.4f}")
-    print(f"out of view: {summary['out_of_view']:.1%} of frames")
-    print(f"time to first centre: {'never' if ttc is None else f'{ttc:.2f} s'}, "
-          f"overshoot {summary['overshoot']:.0%} of the initial offset")
+    print(f"centring error (fraction of the diagonal, at most {MAX_ERROR:g} a frame): "
+          f"mean {summary['mean_center_error']:.4f}, RMS {summary['rms_center_error']:.4f}")
+    print(f"out of view: {summary['out_of_view']:.1%} of scored frames")
+    print(f"time to first centre: {'never' if ttc is None else f'{ttc:.2f} s'}, overshoot "
+          f"{summary['overshoot']:.0%} of the initial offset (in the {OVERSHOOT_WINDOW_S:g} s after first centring)")
     if args.out:
         print(f"wrote {args.out / 'plot.png'} and {args.out / 'summary.json'}")
     return 0

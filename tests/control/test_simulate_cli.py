@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 import subprocess
 import time
 from pathlib import Path
@@ -41,6 +42,22 @@ def test_summary_reports_the_tracker_and_field_of_view_used(sequence: Path, tmp_
     assert json.loads((out / "summary.json").read_text()) == summary
     code, stdout, _ = simulate([str(sequence), "--fps", "60", "--fov", "50", "--tracker", "oracle"], capsys)
     assert code == 0 and "tracker oracle, view 640x360 at 50.0 deg" in stdout
+
+
+def test_frames_without_truth_are_counted_and_left_out(sequence: Path, tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    gapped, out = tmp_path / "gapped", tmp_path / "out"
+    shutil.copytree(sequence, gapped)
+    truth = gapped / "groundtruth_rect.txt"
+    rows = truth.read_text().splitlines()
+    rows[4:8] = ["NaN,NaN,NaN,NaN", "NaN,NaN,NaN,NaN", "0,0,0,0", "0,0,0,0"]
+    truth.write_text("\n".join(rows) + "\n")
+    code, stdout, _ = simulate([str(gapped), "--size", "480x270", "--fps", "60", "--tracker", "oracle",
+                                "--out", str(out)], capsys)
+    assert code == 0 and stdout.startswith("12 frames (8 with ground truth, scored), controller pid")
+    assert "out of view: 0.0% of scored frames" in stdout
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["frames"] == 12 and summary["frames_scored"] == 8 and (out / "plot.png").stat().st_size > 0
 
 
 def test_a_subject_starting_outside_the_view_is_a_one_line_error(sequence: Path,

@@ -2,6 +2,7 @@ import cv2
 import numpy as np
 import pytest
 
+from pipelines.control.metrics import MAX_ERROR
 from pipelines.virtual_camera import VirtualCamera
 
 
@@ -46,8 +47,38 @@ def test_boxes_map_where_the_render_puts_them():
 def test_centre_error_and_out_of_view():
     vc = VirtualCamera((1280, 720))
     err, inside = vc.center_error((1270, 710, 4, 4), 0.0, 0.0)  # source corner: outside the view
-    assert not inside and err > 0.5
+    assert not inside and err == pytest.approx(MAX_ERROR)  # capped
     err, inside = vc.center_error((640 + 320 - 1, 358, 0, 4), 0.0, 0.0)  # at the view's right edge
     assert inside and err == pytest.approx(319 / np.hypot(640, 360), abs=1e-3)
     assert vc.box_to_view((0, 0, 10, 10), 0.0, 0.0) is not None
     assert vc.box_to_view((0, 0, 10, 10), 180.0, 0.0) is None  # behind the view
+
+
+@pytest.mark.parametrize("yaw, pitch, direction", [
+    (80.0, 0.0, (-1.0, 0.0)),  # 80 deg to the left, in front: tan(80) f / diagonal would be 4.3
+    (120.0, 0.0, (-1.0, 0.0)),  # behind, to the left (1.0 before)
+    (0.0, -120.0, (0.0, -1.0)),  # behind, above
+    (180.0, 0.0, None),  # straight behind: any direction
+])
+def test_error_is_capped_at_max_error_towards_the_subject(yaw, pitch, direction):
+    """An out-of-view subject scores at most MAX_ERROR wherever it went, so mean and RMS stay
+    comparable between runs that lose it."""
+    vc = VirtualCamera((1280, 720))
+    dx, dy, inside = vc.center_offset((636, 356, 8, 8), yaw, pitch)  # the source's centre
+    assert not inside and np.hypot(dx, dy) == pytest.approx(MAX_ERROR)
+    if direction is not None:
+        assert (dx, dy) == pytest.approx(np.multiply(direction, MAX_ERROR), abs=1e-9)
+
+
+def test_a_capped_offset_keeps_its_direction():
+    vc = VirtualCamera((1280, 720), hfov_deg=30.0)
+    dx, dy, inside = vc.center_offset((1270, 10, 4, 4), 0.0, 0.0)  # the source's top-right corner
+    (x, y), = vc.to_view(np.array([[1272.0, 12.0]]), 0.0, 0.0)
+    assert not inside and np.hypot(dx, dy) == pytest.approx(MAX_ERROR)
+    assert np.arctan2(dy, dx) == pytest.approx(np.arctan2(y - vc.camera.cy, x - vc.camera.cx))
+
+
+@pytest.mark.parametrize("box", [(np.nan,) * 4, (10.0, np.nan, 5.0, 5.0)])
+def test_a_box_without_a_centre_is_refused(box):
+    with pytest.raises(ValueError, match="no finite centre"):
+        VirtualCamera((1280, 720)).center_offset(box, 0.0, 0.0)
