@@ -445,6 +445,8 @@ class GimbalClient:
             for attempt in range(retries + 1):
                 if attempt:
                     self.stats["retries"] += 1
+                    log.warning("%s: no reply within %.0f ms, resending (attempt %d of %d)", message.NAME,
+                                timeout * 1000, attempt + 1, retries + 1)
                     with self._lock:
                         self._pending.setdefault(waiter.seq, waiter)
                     self._transmit(message, waiter.raw)

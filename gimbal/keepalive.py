@@ -26,6 +26,7 @@ from gimbal.messages.motion import SpeedControl, to_raw
 log = logging.getLogger(__name__)
 
 MAX_SPEED_DPS = 360.0
+STAT_KEYS = ("sent", "zero_sent", "replies", "reply_errors", "reply_timeouts")  # in stats from the start
 MIN_RATE_HZ = 4.0  # at least two sends inside the gimbal's 0.5 s window
 MAX_RATE_HZ = 50.0  # public drivers use 10-50 Hz; a new setpoint may go out at twice the rate, and
 # each reply (a few ms) must be back by the next send, half a period later at the least
@@ -67,7 +68,7 @@ class SpeedStreamer:
         self.rate_hz = rate_hz
         self.max_age = max_age
         self.max_missed_replies = max_missed_replies
-        self.stats: Counter[str] = Counter()  # sent, zero_sent, replies, reply_errors, reply_timeouts
+        self.stats: Counter[str] = Counter(dict.fromkeys(STAT_KEYS, 0))
         self.error: BaseException | None = None
         self._client = client
         self._clock = clock
@@ -186,6 +187,7 @@ class SpeedStreamer:
         if not pending.done:
             self.stats["reply_timeouts"] += 1
             self._missed += 1
+            log.warning("speed command: no reply before the next one (%d in a row)", self._missed)
             if self._missed >= self.max_missed_replies:
                 raise BusError(f"no reply to {self._missed} consecutive speed commands")
             return

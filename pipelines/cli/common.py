@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
@@ -47,6 +48,17 @@ def parse_int(text: str) -> int:
         return int(text, 0)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+
+
+def parse_seconds(text: str) -> float:
+    """A duration in seconds: a finite number, 0 or more."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 <= value < math.inf:
+        raise argparse.ArgumentTypeError(f"not a duration in seconds (a finite number, 0 or more): {text!r}")
+    return value
 
 
 def parse_can_id(text: str) -> int:

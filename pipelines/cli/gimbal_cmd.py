@@ -34,7 +34,7 @@ from gimbal.messages.tlv_params import (ROLL360_MODES, AutoCalibration, Calibrat
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
 from pipelines.cli.bus import open_host_bus
-from pipelines.cli.common import CliError, add_bus_options, parse_int, suppress_defaults
+from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds, suppress_defaults
 
 Result = dict[str, Any]
 LIMITS = tuple(LIMIT_RANGES)
@@ -52,7 +52,7 @@ class Command:
     name: str
     help: str
     messages: Callable[[argparse.Namespace], list[Message]]
-    run: Callable[[GimbalClient, argparse.Namespace], Result]
+    run: Callable[[GimbalClient, argparse.Namespace], Result | None]  # None: it printed its own output
     arguments: Callable[[argparse.ArgumentParser], None] = lambda parser: None
     cmd_types: dict[type[Message], int] = field(default_factory=dict)
 
@@ -176,14 +176,12 @@ def _move(client: GimbalClient, args: argparse.Namespace) -> Result:
 def _speed_args(p: argparse.ArgumentParser) -> None:
     for axis in ("yaw", "pitch", "roll"):
         p.add_argument(f"--{axis}", type=float, default=0.0, help=f"{axis} speed in °/s (-360..360)")
-    p.add_argument("--duration", type=float, default=1.0, help="seconds to keep turning (default 1)")
+    p.add_argument("--duration", type=parse_seconds, default=1.0, help="seconds to keep turning (default 1)")
     p.add_argument("--rate", type=float, default=25.0,
                    help=f"keep-alive rate in Hz, {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} (default 25)")
 
 
 def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:
-    if not args.duration >= 0:
-        raise CliError("--duration must be >= 0")
     try:
         streamer = client.speed_streamer(rate_hz=args.rate)
     except ValueError as exc:
@@ -195,8 +193,13 @@ def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:
             time.sleep(min(0.1, remaining))
     finally:
         streamer.stop()
-    return {"duration_s": args.duration, **{k: streamer.stats[k] for k in
-                                             ("sent", "reply_errors", "reply_timeouts")}}
+    stats = streamer.stats
+    if stats["reply_errors"] or not stats["replies"]:
+        failed = " and ".join(f"{what} {stats[key]}" for what, key in (("refused", "reply_errors"),
+                                                                     ("did not answer", "reply_timeouts"))
+                              if stats[key])
+        raise CliError(f"the gimbal {failed or 'did not answer'} of {stats['sent']} speed commands", exit_code=1)
+    return {"duration_s": args.duration, **{k: stats[k] for k in ("sent", "reply_errors", "reply_timeouts")}}
 
 
 def _limits_args(p: argparse.ArgumentParser) -> None:
@@ -250,11 +253,11 @@ def _stiffness(client: GimbalClient, args: argparse.Namespace) -> Result:
 
 
 def _watch_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--duration", type=float, help="stop after this many seconds (default: Ctrl-C)")
+    p.add_argument("--duration", type=parse_seconds, help="stop after this many seconds (default: Ctrl-C)")
     p.add_argument("--no-enable", action="store_true", help="do not send 'push on' first")
 
 
-def _watch(client: GimbalClient, args: argparse.Namespace) -> Result:
+def _watch(client: GimbalClient, args: argparse.Namespace) -> None:
     arrived: queue.Queue[tuple[Message, float]] = queue.Queue()
     start = time.monotonic()  # before subscribing: a push may arrive before set_push returns
     for cls in (ParameterPush, CalibrationStatusPush):
@@ -277,7 +280,7 @@ def _watch(client: GimbalClient, args: argparse.Namespace) -> Result:
         pass
     except BrokenPipeError:  # e.g. piped into head: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-    return {}
+    return None
 
 
 def _version_args(p: argparse.ArgumentParser) -> None:
@@ -379,13 +382,13 @@ def _focus(client: GimbalClient, args: argparse.Namespace) -> Result:
 def _joystick_args(p: argparse.ArgumentParser) -> None:
     for axis in ("yaw", "pitch", "roll"):
         p.add_argument(f"--{axis}", type=int, default=0, help=f"{axis} stick, raw -15000..15000")
-    p.add_argument("--duration", type=float, default=0.5,
+    p.add_argument("--duration", type=parse_seconds, default=0.5,
                    help=f"seconds to hold it (sent at {STREAM_HZ:g} Hz, then centred; default 0.5)")
 
 
 def _dial_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("speed", type=int, help="dial speed, raw -2048..2048")
-    p.add_argument("--duration", type=float, default=0.5,
+    p.add_argument("--duration", type=parse_seconds, default=0.5,
                    help=f"seconds to hold it (sent at {STREAM_HZ:g} Hz, then zeroed; default 0.5)")
 
 
@@ -515,6 +518,8 @@ def run(command: Command, args: argparse.Namespace) -> int:
         raise CliError(f"the gimbal did not answer: {exc}", exit_code=1) from None
     except GimbalError as exc:
         raise CliError(str(exc), exit_code=1) from None
+    if result is None:
+        return 0
     if args.json:
         print(json.dumps(result))
     elif result:

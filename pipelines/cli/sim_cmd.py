@@ -15,7 +15,7 @@ from gimbal.messages.motion import AXES
 from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
 from gimbal.sim.faults import DIRECTIONS
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, open_can_bus
-from pipelines.cli.common import CliError, add_bus_options, parse_int
+from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -63,7 +63,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="add foreign frames (0x530/0x531/0x426, 0x55 packets) at this rate")
     faults.add_argument("--seed", type=int, default=0, help="fault RNG seed (default 0)")
     run_group = parser.add_argument_group("run")
-    run_group.add_argument("--duration", type=float, metavar="S", help="stop after this many seconds")
+    run_group.add_argument("--duration", type=parse_seconds, metavar="S", help="stop after this many seconds")
     run_group.add_argument("--status-interval", type=float, default=1.0, metavar="S",
                            help="print the state every S seconds (default 1; 0: never)")
     run_group.add_argument("--json", action="store_true", help="print the full state as JSON lines")

@@ -117,6 +117,28 @@ def test_speed_streams_then_stops_and_releases(channel: str, peer: ScriptedPeer,
     assert json.loads(capsys.readouterr().out)["reply_timeouts"] == 0
 
 
+@pytest.mark.parametrize("answer", ["nack", "silence"])
+def test_speed_refused_or_unanswered_is_a_one_line_error(channel: str, peer: ScriptedPeer, answer: str,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """Both once ended with exit 0 (silence: when shorter than the keep-alive's 10 missed replies)."""
+    if answer == "nack":
+        peer.nack(SpeedControl, 0x02)
+    assert gimbal(channel, "speed", "--yaw", "5", "--duration", "0.2") == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ("refused" if answer == "nack" else "did not answer") in err
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+
+
+@pytest.mark.parametrize("command", [["joystick", "--yaw", "5"], ["dial", "5"], ["watch"], ["speed"]])
+@pytest.mark.parametrize("duration", ["nan", "inf", "-1"])
+def test_a_duration_that_never_ends_or_is_negative_is_refused(channel: str, command: list[str], duration: str,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """joystick and dial with --duration nan once held the stick push until killed."""
+    with pytest.raises(SystemExit) as exited:
+        gimbal(channel, *command, "--duration", duration)
+    assert exited.value.code == 2 and "not a duration in seconds" in capsys.readouterr().err
+
+
 def test_silence_is_a_one_line_error(channel: str, peer: ScriptedPeer,
                                      capsys: pytest.CaptureFixture[str]) -> None:
     assert gimbal(channel, "camera-status", "--timeout", "0.05") == 1
@@ -221,7 +243,7 @@ def test_the_simulated_gimbal_answers(capsys: pytest.CaptureFixture[str]) -> Non
     assert json.loads(capsys.readouterr().out)["device_id"] == 1
     assert main(["gimbal", "watch", "-i", "sim", "--duration", "0.3", "--json"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines and json.loads(lines[0])["push"] == "parameter_push"
+    assert lines and all(json.loads(line)["push"] == "parameter_push" for line in lines)  # once a last {}
 
 
 def test_sigterm_to_a_streaming_process_stops_and_releases() -> None:

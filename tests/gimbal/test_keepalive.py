@@ -8,7 +8,7 @@ import pytest
 
 from gimbal.client import GimbalClient
 from gimbal.errors import BusError, GimbalError, RangeError
-from gimbal.keepalive import SpeedStreamer
+from gimbal.keepalive import STAT_KEYS, SpeedStreamer
 from gimbal.messages.motion import SpeedControl
 from tests.gimbal.scripted_peer import (
     RELEASE,
@@ -225,3 +225,10 @@ def test_a_stop_repeated_after_an_interrupted_one_waits_for_the_last_send(
 def test_rates_outside_4_to_50_hz_are_refused(client: GimbalClient, rate: float) -> None:
     with pytest.raises(ValueError, match="4 to 50 Hz"):
         SpeedStreamer(client, rate_hz=rate)
+
+
+def test_every_count_is_in_the_stats_from_the_start(client: GimbalClient) -> None:
+    """Counts that stayed 0 were missing, so summary.json lacked the keys docs/track.md lists."""
+    streamer = client.speed_streamer()
+    streamer.stop()
+    assert set(STAT_KEYS) <= set(streamer.stats) and streamer.stats["reply_errors"] == 0
