@@ -13,6 +13,13 @@ from tests.gimbal.scripted_peer import ScriptedPeer
 from tracker.data_paths import DATA_ENV, shared_data_dir
 
 
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark every test that uses the ``shared_data`` fixture, so ``-m "not shared_data"`` leaves them out."""
+    for item in items:
+        if "shared_data" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.shared_data)
+
+
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
     """The shared benchmark data: fails under CI when missing, skips (with the reason) elsewhere."""

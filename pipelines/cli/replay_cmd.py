@@ -230,11 +230,11 @@ def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
         finally:
             if bus is not None and summary.frames_sent and (not completed or summary.holds_control):
                 _stop_gimbal(bus, args.tx_id, args.rx_id)
-        _print(out, args.json, {"summary": summary.as_dict()}, summary.text())
-        if sim is not None:
+        if sim is not None:  # before the summary, which stays the last object
             state = _settled(sim)
             _print(out, args.json, {"sim_state": state.as_dict()},
                    "simulated gimbal at the end: " + status_line(state, time.monotonic() - started))
+        _print(out, args.json, {"summary": summary.as_dict()}, summary.text())
     return 0
 
 

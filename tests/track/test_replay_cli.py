@@ -61,8 +61,8 @@ def test_onto_the_simulator(session_log: Path, capsys: pytest.CaptureFixture[str
     capsys.readouterr()
     assert main(["replay", str(session_log), "--json", "-i", "sim", "--speed", "4"]) == 0
     objects = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    state = objects[-1]["sim_state"]
-    assert objects[-2]["summary"]["frames_sent"] > 0
+    state = objects[-2]["sim_state"]
+    assert objects[-1]["summary"]["frames_sent"] > 0  # the summary stays last, as without -i sim
     assert state["speeds"] == [0.0, 0.0, 0.0] and not state["speed_control"]
     assert state["joint"][0] > 1.0 and state["joint"][2] > 1.0  # it turned right and up
 
