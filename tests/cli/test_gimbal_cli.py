@@ -20,7 +20,7 @@ from gimbal.messages.telemetry import ParameterPush, PushControl, PushControlRep
 from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv
 from pipelines.cli import main
 from tests.gimbal.scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages
-from tests.support import cli_command
+from tests.support import cli_command, free_udp_port, subprocess_env
 
 DOC_EXAMPLE = "AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE"
 
@@ -250,12 +250,13 @@ def test_sigterm_to_a_streaming_process_stops_and_releases() -> None:
     """End to end in two processes over udp_multicast: the CLI streams speed, gets SIGTERM, and
     its last words on the bus are zero speed and release."""
     group = f"239.{random.randint(1, 254)}.{random.randint(1, 254)}.{random.randint(1, 254)}"
-    bus = can.Bus(interface="udp_multicast", channel=group)
+    port = free_udp_port()  # a port of its own: nothing else on the machine hears or sends on it
+    bus = can.Bus(interface="udp_multicast", channel=group, port=port)
     with ScriptedPeer(bus) as peer:
         peer.answer(SpeedControl)
         child = subprocess.Popen(cli_command("gimbal", "speed", "--yaw", "15", "--duration", "60",
                                              "-i", "udp_multicast", "-c", group),
-                                 stderr=subprocess.PIPE, text=True)
+                                 stderr=subprocess.PIPE, text=True, env=subprocess_env(port))
         try:
             peer.wait_for(SpeedControl, 3, timeout=20.0, where=lambda m: m.yaw_speed == 150)
             child.send_signal(signal.SIGTERM)

@@ -15,10 +15,12 @@ from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, ReturnCodeError
 from gimbal.messages.telemetry import ParameterPush
 from pipelines.cli import build_parser, main
-from tests.support import ROOT, cli_command
+from tests.support import ROOT, cli_command, free_udp_port, subprocess_env
 
-# Non-default ids keep this test apart from anything else on the shared multicast port.
+# Non-default ids, and a port of its own, keep this test apart from anything else using udp_multicast.
 IDS = ["--tx-id", "0x323", "--rx-id", "0x322"]
+PORT = free_udp_port()
+ENV = subprocess_env(PORT)
 
 
 def group() -> str:
@@ -30,7 +32,7 @@ def sim_process() -> Iterator[tuple[subprocess.Popen[str], str]]:
     channel = group()
     proc = subprocess.Popen(cli_command("sim", "-i", "udp_multicast", "-c", channel, *IDS,
                                         "--status-interval", "0.2", "--push-rate", "40", "--version", "01.02.0A.0B"),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, env=ENV)
     yield proc, channel
     if proc.poll() is None:
         proc.kill()
@@ -38,7 +40,8 @@ def sim_process() -> Iterator[tuple[subprocess.Popen[str], str]]:
 
 
 def connect(channel: str) -> GimbalClient:
-    client = GimbalClient(interface="udp_multicast", channel=channel, tx_id=0x323, rx_id=0x322, timeout=0.1)
+    client = GimbalClient(interface="udp_multicast", channel=channel, port=PORT, tx_id=0x323, rx_id=0x322,
+                          timeout=0.3)
     deadline = time.monotonic() + 5.0
     while True:
         try:
@@ -90,7 +93,8 @@ def test_gimbal_cli_drives_the_simulator_process(sim_process) -> None:
     bus = ["-i", "udp_multicast", "-c", channel, *IDS, "--timeout", "0.3"]
 
     def gimbal(*args: str) -> None:
-        done = subprocess.run(cli_command("gimbal", *args, *bus), capture_output=True, text=True, timeout=30)
+        done = subprocess.run(cli_command("gimbal", *args, *bus), capture_output=True, text=True, timeout=30,
+                              env=ENV)
         assert done.returncode == 0, done.stderr
 
     with connect(channel) as client:
@@ -112,7 +116,7 @@ def test_duration_status_lines_and_json(capsys) -> None:
 @pytest.mark.parametrize("args, message", [
     (["--drop", "1.5"], "Faults.drop is a fraction"),
     (["--push-rate", "0"], "push_rate_hz must be positive"),
-    (["--duration", "-1"], "--duration must be positive"),
+    (["--duration", "0"], "--duration must be positive"),
     (["--tx-id", "0x222"], "must differ"),
     (["-i", "sim"], "in-process simulator"),
     (["-i", "no_such_interface"], "cannot open the CAN bus"),
@@ -123,7 +127,8 @@ def test_bad_input_is_a_one_line_error(capsys, args: list[str], message: str) ->
     assert message in err and len(err.splitlines()) == 1
 
 
-@pytest.mark.parametrize("args", [["--silent", "3:1"], ["--version", "1.2.3"], ["--fault-direction", "up"]])
+@pytest.mark.parametrize("args", [["--silent", "3:1"], ["--version", "1.2.3"], ["--fault-direction", "up"],
+                                  ["--duration", "-1"], ["--duration", "nan"]])  # nan once ran for ever
 def test_malformed_options_are_usage_errors(capsys, args: list[str]) -> None:
     with pytest.raises(SystemExit) as exc:
         main(["sim", *args])
