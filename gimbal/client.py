@@ -67,6 +67,7 @@ ORIENTATIONS = {"keep": 0x00, "landscape": 0x01, "landscape-flipped": 0x02, "por
 FOCUS_CALIBRATIONS = {name.replace("_", "-"): code for code, name in FOCUS_CALIBRATION_COMMANDS.items()}
 SPEED_HOLD = SPEED_TAKE_CONTROL | SPEED_IGNORE_FOCAL_LENGTH  # 0x88: in control
 SPEED_RELEASE = SPEED_IGNORE_FOCAL_LENGTH  # 0x08: bit 7 clear, control released
+DEFAULT_MAX_AGE_S = 0.3  # the speed keep-alive replaces a setpoint this old by zero
 
 R = TypeVar("R", bound=Reply)
 
@@ -519,7 +520,7 @@ class GimbalClient:
         """One speed command in °/s; the gimbal keeps it 0.5 s (use ``speed_streamer`` to hold it)."""
         self.request(speed_message(yaw, pitch, roll, take_control=take_control))
 
-    def speed_streamer(self, rate_hz: float = 25.0, max_age: float = 0.3) -> SpeedStreamer:
+    def speed_streamer(self, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S) -> SpeedStreamer:
         """Start the speed keep-alive (see ``gimbal.keepalive``); one per client at a time."""
         from gimbal.keepalive import SpeedStreamer
         self._check_alive()

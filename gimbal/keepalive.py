@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import can
 
-from gimbal.client import SPEED_HOLD, GimbalClient, PendingReply
+from gimbal.client import DEFAULT_MAX_AGE_S, SPEED_HOLD, GimbalClient, PendingReply
 from gimbal.errors import BusError, GimbalError, RangeError
 from gimbal.messages.motion import SpeedControl, to_raw
 
@@ -58,7 +58,7 @@ class SpeedStreamer:
     stop is sent, ``error`` is set and the next ``set()`` raises ``BusError``.
     """
 
-    def __init__(self, client: GimbalClient, rate_hz: float = 25.0, max_age: float = 0.3, *,
+    def __init__(self, client: GimbalClient, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S, *,
                  max_missed_replies: int = 10, clock: Callable[[], float] = time.monotonic) -> None:
         if not MIN_RATE_HZ <= rate_hz <= MAX_RATE_HZ:
             raise ValueError(f"the keep-alive rate must be {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz (a command "

@@ -9,6 +9,7 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Protocol
 
+from gimbal.client import DEFAULT_MAX_AGE_S
 from pipelines.control.camera import CameraModel
 from pipelines.control.direction import Direction, DirectionFilter, PredictionTrust, compose, wrap_deg
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate
@@ -38,12 +39,15 @@ class ControlConfig:
     trust_memory_s: float = 1.0  # memory of the prediction scoring (PredictionTrust)
     reversal_factor: float = 2.0  # scoring horizon += this * (time to reverse the target's speed)
     first_step_s: float = 1 / 30  # the first setpoint may step from rest by max_accel_dps2 * this
+    setpoint_max_age_s: float = DEFAULT_MAX_AGE_S  # the keep-alive streams zero once a setpoint is this old
 
     def __post_init__(self) -> None:
         if not 0.0 < self.max_speed_dps <= PROTOCOL_MAX_SPEED_DPS:
             raise ValueError(f"max_speed_dps must be in (0, {PROTOCOL_MAX_SPEED_DPS:g}]")
-        if self.max_accel_dps2 <= 0 or self.hold_s < 0 or self.ramp_s <= 0 or self.first_step_s <= 0:
-            raise ValueError("max_accel_dps2, ramp_s and first_step_s must be positive, hold_s non-negative")
+        if (self.max_accel_dps2 <= 0 or self.hold_s < 0 or self.ramp_s <= 0 or self.first_step_s <= 0
+                or self.setpoint_max_age_s <= 0):
+            raise ValueError("max_accel_dps2, ramp_s, first_step_s and setpoint_max_age_s must be positive, "
+                             "hold_s non-negative")
         if self.max_speed_dps / self.ramp_s > self.max_accel_dps2 * (1 + 1e-9):
             raise ValueError("the stop ramp from max_speed_dps over ramp_s would exceed max_accel_dps2")
 
@@ -80,6 +84,18 @@ class Controller(Protocol):
     def reset(self) -> None: ...
 
 
+def _time_step(config: ControlConfig, last_now: float | None, now: float) -> tuple[float, bool]:
+    """The time step the PID and the acceleration limit see, and whether the loop starts from rest.
+
+    At the start, and after a gap in which the keep-alive has replaced the last setpoint by zero
+    (longer than ``setpoint_max_age_s``), the gimbal was last told zero: the next setpoint steps
+    from rest as if that zero were ``first_step_s`` old, instead of integrating the whole gap.
+    """
+    if last_now is None or now - last_now > config.setpoint_max_age_s:
+        return config.first_step_s, True
+    return now - last_now, False
+
+
 def _tracking(estimate: TargetEstimate | None) -> bool:
     """A detection to steer by: tracked, with a finite centre (a NaN would poison the filter)."""
     return (estimate is not None and estimate.state is TrackState.TRACKING
@@ -91,9 +107,11 @@ class RateController:
 
     Each detection is turned into a world direction (image offset composed with the gimbal
     attitude at the frame's time) and filtered by a constant-velocity Kalman filter. The target
-    is extrapolated to when the new setpoint will act (``now + actuation_delay_s``); the gimbal's
-    pointing at that time is predicted from the attitude at frame time plus the setpoints already
-    sent (a Smith predictor), so pipeline latency does not destabilise the loop.
+    is extrapolated to when the new setpoint will act (``now + actuation_delay_s``), at most
+    ``max_prediction_s`` past its frame and held there beyond; the gimbal's pointing at that same
+    time is predicted from the attitude at frame time plus all the setpoints already sent (a Smith
+    predictor), so pipeline latency does not destabilise the loop. Without a measured attitude
+    the pointing is dead-reckoned from the setpoints, from an assumed (0, 0) until one arrives.
     The extrapolation and the feed-forward are scaled by a trust (:class:`PredictionTrust`):
     the share of the predicted motion that has been coming true over the time the loop needs
     to act and to reverse the target's speed at the acceleration limit. Smooth motion keeps it
@@ -120,11 +138,41 @@ class RateController:
         self._pid_yaw, self._pid_pitch = self._pid(), self._pid()
         self._direction: Direction | None = None
         self._attitude: tuple[float, float, float] | None = None  # yaw, pitch, time
+        self._assumed = False  # _attitude is dead-reckoned from an assumed (0, 0): none measured yet
         self._sent: deque[tuple[float, float, float]] = deque(maxlen=256)  # time, yaw, pitch
         self._last_now: float | None = None
         self._last_good: float = -math.inf
         self._ramp_from: tuple[float, float] | None = None
         self._yaw_unwrapped = 0.0
+        self._last = RateCommand(0.0, 0.0)
+
+    def _take_attitude(self, attitude: tuple[float, float] | None, frame_t: float, captured: bool) -> bool:
+        """Set the pointing reference: the measured ``attitude`` at ``frame_t``, else dead-reckoned
+        (moved up to each frame's capture time, so the setpoints before it are no longer needed),
+        starting from an assumed (0, 0) until an attitude is measured. True when a measured
+        attitude replaces the assumed one: the world frame has changed."""
+        if attitude is not None:
+            reframed = self._assumed
+            self._attitude, self._assumed = (attitude[0], attitude[1], frame_t), False
+            return reframed
+        if self._attitude is None:
+            self._attitude, self._assumed = (0.0, 0.0, frame_t), True
+        elif captured and frame_t > self._attitude[2]:
+            self._attitude = (*self._pointing(frame_t), frame_t)
+        return False
+
+    def _forget_target(self) -> None:
+        """Start the target's filter, trust and PID afresh (a new acquisition, a new world frame)."""
+        self._filter.reset()
+        self._trust.reset()
+        self._direction = None
+        self._pid_yaw.reset(self._last.yaw_dps)
+        self._pid_pitch.reset(self._last.pitch_dps)
+
+    def _restart_from_rest(self) -> None:
+        """Forget the PID state and take the last setpoint as zero, as the gimbal was told."""
+        self._pid_yaw.reset()
+        self._pid_pitch.reset()
         self._last = RateCommand(0.0, 0.0)
 
     def _integrate_sent(self, t0: float, t1: float) -> tuple[float, float]:
@@ -155,23 +203,22 @@ class RateController:
         """One setpoint for the frame behind ``estimate`` (``None``: no frame or no detection).
 
         ``attitude`` is the gimbal (yaw, pitch) in degrees at the frame's capture time (at ``now``
-        without an estimate); when ``None`` it is dead-reckoned from the setpoints sent.
+        without an estimate); when ``None`` it is dead-reckoned from the setpoints sent (from an
+        assumed (0, 0) if none was ever given).
         """
         c = self.config
-        # the first setpoint steps from rest as if the previous one (zero) were first_step_s old
-        dt = c.first_step_s if self._last_now is None else now - self._last_now
+        dt, from_rest = _time_step(c, self._last_now, now)
         self._last_now = now
+        if from_rest:
+            self._restart_from_rest()
         frame_t = estimate.timestamp if estimate is not None else now
-        if attitude is not None:
-            self._attitude = (attitude[0], attitude[1], frame_t)
+        if self._take_attitude(attitude, frame_t, captured=estimate is not None):
+            self._forget_target()  # the world frame moved from the assumed attitude to the measured one
 
-        measured = _tracking(estimate) and self._attitude is not None
+        measured = _tracking(estimate)
         if measured:
             if now - self._last_good > c.stop_within_s:  # a new acquisition starts afresh
-                self._filter.reset()
-                self._trust.reset()
-                self._pid_yaw.reset(self._last.yaw_dps)
-                self._pid_pitch.reset(self._last.pitch_dps)
+                self._forget_target()
             world = compose(self._pointing(frame_t), self.camera.pixel_to_angles(*estimate.center))
             if attitude is not None:  # with a dead-reckoned pointing it would score our own model
                 self._trust.observe(world, frame_t, self._scoring_horizon(now, frame_t))
@@ -207,9 +254,9 @@ class RateController:
 
     def _follow(self, dt: float, now: float, estimate: TargetEstimate | None, mode: str) -> RateCommand:
         c, d = self.config, self._direction
-        t_act = min(now + c.actuation_delay_s, d.timestamp + c.max_prediction_s)
+        t_act = now + c.actuation_delay_s
         w = self._trust.weight  # use the prediction only as far as it has been coming true
-        ahead = d.at(t_act)
+        ahead = d.at(min(t_act, d.timestamp + c.max_prediction_s))  # held beyond the horizon
         target = wrap_deg(d.yaw + w * wrap_deg(ahead[0] - d.yaw)), d.pitch + w * (ahead[1] - d.pitch)
         gimbal = self._pointing(t_act)
         e_yaw, e_pitch = wrap_deg(target[0] - gimbal[0]), target[1] - gimbal[1]
@@ -268,7 +315,13 @@ class ProportionalController:
 
     def update(self, estimate: TargetEstimate | None, attitude: tuple[float, float] | None,
                now: float) -> RateCommand:
-        dt = 0.0 if self._last_now is None else now - self._last_now
+        if self._last_now is None:  # as public drivers do: the first frame only starts the clock
+            dt = 0.0
+        else:
+            dt, from_rest = _time_step(self.config, self._last_now, now)
+            if from_rest:  # the keep-alive has zeroed the last setpoint: slew on from zero
+                self._pid_yaw.reset()
+                self._pid_pitch.reset()
         self._last_now = now
         if dt <= 0.0:
             return self._last

@@ -12,6 +12,7 @@ from pipelines.control.controller import (
 from tracker.estimate import TargetEstimate, TrackState
 
 CAM = CameraModel(640, 360)
+KEEPALIVE_MAX_AGE_S = 0.3  # the speed streamer sends zero instead of a setpoint this old
 
 
 def ramp(t):
@@ -20,6 +21,10 @@ def ramp(t):
 
 def sine(t):
     return 15.0 * math.sin(math.pi * t), 5.0 * math.sin(0.6 * math.pi * t)
+
+
+def step(t):
+    return (10.0 if t >= 1.0 else 0.0), 0.0
 
 
 def pid():
@@ -51,20 +56,47 @@ def test_sine_rms_is_at_most_half_the_baseline(latency):
 
 
 def test_step_settles_with_little_overshoot():
-    tr = run_scene(pid(), lambda t: (10.0 if t >= 1.0 else 0.0, 0.0), 4.0)
+    tr = run_scene(pid(), step, 4.0)
     yaw_err = tr.window("yaw_err", 1.0)
     assert -yaw_err.min() < 0.1 * 10.0  # overshoot under 10 %
     assert np.abs(tr.window("yaw_err", 3.0)).max() < 0.5
 
 
+class BlindController(RateController):
+    """The same loop without latency compensation: the gimbal is taken to point where it did
+    at capture, and the target is not extrapolated."""
+
+    def _pointing(self, t: float) -> tuple[float, float]:
+        return self._attitude[:2]
+
+
 def test_latency_compensation_keeps_a_delayed_loop_damped():
     def overshoot(ctl):
-        tr = run_scene(ctl, lambda t: (10.0 if t >= 1.0 else 0.0, 0.0), 4.0, latency=0.1)
+        tr = run_scene(ctl, step, 4.0, latency=0.1)
         return -tr.window("yaw_err", 1.0).min()
 
-    blind = RateController(CAM, ControlConfig(actuation_delay_s=0.0, max_prediction_s=0.0))
+    blind = BlindController(CAM, ControlConfig(actuation_delay_s=0.0, max_prediction_s=0.0))
     assert overshoot(pid()) < 0.5
     assert overshoot(blind) > 3.0  # the same gains without the predictor ring
+
+
+@pytest.mark.parametrize("latency", [0.4, 0.6])
+def test_latency_beyond_the_prediction_cap_is_still_compensated(latency):
+    """max_prediction_s caps the target's extrapolation only: the predicted pointing still counts
+    every setpoint sent, however long the capture-to-command latency (it once oscillated)."""
+    tr = run_scene(pid(), step, 5.0, latency=latency)
+    assert -tr.window("yaw_err", 1.0).min() < 1.0
+    assert np.abs(tr.window("yaw_err", 3.5)).max() < 0.2
+
+
+def test_a_ramp_beyond_the_prediction_cap_trails_by_the_held_part():
+    """Beyond the cap the target is held where it was predicted at the cap: the gimbal trails a
+    ramp by speed * (latency + actuation_delay_s - max_prediction_s), steadily."""
+    cfg, latency = ControlConfig(), 0.6
+    tr = run_scene(RateController(CAM, cfg), ramp, 6.0, latency=latency)
+    held = math.hypot(20.0, 5.0) * (latency + cfg.actuation_delay_s - cfg.max_prediction_s)
+    err = tr.window("err", 4.0)
+    assert np.abs(err - held).max() < 0.15 * held
 
 
 @pytest.mark.parametrize("latency", [0.0, 0.1])
@@ -81,6 +113,50 @@ def test_loss_stops_within_the_configured_time(latency):
     assert set(mode[t > last_track]) <= {"hold", "ramp", "idle"}
     assert np.all(np.abs(np.diff(yaw[t > last_track])) <= cfg.max_accel_dps2 * (1 / 30) + 1e-9)
     assert abs(tr.window("gimbal_rate", 3.0)).max() < 1e-3  # and the gimbal stands still
+
+
+def pan_across_a_stall(name: str, stall_s: float) -> list[tuple[float, float, float, float]]:
+    """A 10 deg/s pan followed at 30 fps by a rate-integrating gimbal, no frame processed for
+    ``stall_s`` from t = 1 s; as the keep-alive does, a setpoint over 0.3 s old is streamed as zero.
+    Returns (time, error deg, commanded yaw, yaw streamed until then) per processed frame."""
+    ctl = make_controller(name, camera=CAM)
+    gimbal = cmd = sent_at = 0.0
+    rows = []
+    for k in range(1, int((4.0 + stall_s) * 30)):
+        t = k / 30
+        streamed = cmd if t - sent_at <= KEEPALIVE_MAX_AGE_S else 0.0
+        gimbal += streamed / 30
+        if 1.0 <= t < 1.0 + stall_s:
+            continue
+        offset = 10.0 * t - gimbal
+        x = CAM.cx + CAM.focal_px * math.tan(math.radians(offset))
+        est = TargetEstimate((x - 10, CAM.cy - 10, 20, 20), (0, 0), 0.9, TrackState.TRACKING, t, k)
+        cmd, sent_at = ctl.update(est, (gimbal, 0.0), t).yaw_dps, t
+        rows.append((t, offset, cmd, streamed))
+    return rows
+
+
+@pytest.mark.parametrize("name", ["pid", "p"])
+@pytest.mark.parametrize("stall_s", [1.0, 1.9])
+def test_after_a_frame_stall_the_gimbal_restarts_from_rest(name, stall_s):
+    """A stall longer than the keep-alive's 0.3 s: the gimbal was told zero, so the first setpoint
+    after it steps from zero by at most max_accel * first_step_s, not max_accel * stall."""
+    cfg = ControlConfig()
+    rows = pan_across_a_stall(name, stall_s)
+    first = next(i for i, row in enumerate(rows) if row[0] >= 1.0 + stall_s)
+    _, _, cmd, streamed = rows[first]
+    assert streamed == 0.0 and rows[first - 1][2] > 5.0  # it was moving, then streamed zero
+    assert 0.0 < cmd <= cfg.max_accel_dps2 * cfg.first_step_s + 1e-9
+    after = np.array(rows[first:])
+    assert np.all(np.abs(np.diff(after[:, 2])) <= cfg.max_accel_dps2 * np.diff(after[:, 0]) + 1e-9)
+
+
+@pytest.mark.parametrize("stall_s", [1.0, 1.9])
+def test_the_integral_does_not_wind_up_over_a_stall(stall_s):
+    """The stall is not integrated: the integral once restarted at ki * error * stall (5-16 deg/s)
+    and left a 0.5-1.3 deg offset 1.5 s after it; what remains is the catch-up's own (under 0.2)."""
+    rows = np.array(pan_across_a_stall("pid", stall_s))
+    assert np.abs(rows[rows[:, 0] >= 2.5 + stall_s, 1]).max() < 0.3
 
 
 def test_no_estimate_at_all_after_tracking_stops_the_gimbal():
@@ -138,6 +214,21 @@ def test_yaw_wrap_does_not_upset_the_loop():
     assert max(abs(c.yaw_error_deg) for c in cmds) < 2.0
 
 
+class AttitudeFrom:
+    """Hands the controller the attitude of the frames captured from ``start`` on, offset by
+    ``offset`` (a gimbal whose zero is elsewhere), and none before (pushes not arrived yet)."""
+
+    def __init__(self, start: float, offset: tuple[float, float] = (0.0, 0.0)) -> None:
+        self.ctl, self.start, self.offset = pid(), start, offset
+
+    def update(self, est, att, now):
+        if est is None or est.timestamp < self.start:
+            att = None
+        elif att is not None:
+            att = (att[0] + self.offset[0], att[1] + self.offset[1])
+        return self.ctl.update(est, att, now)
+
+
 def test_missing_attitude_is_dead_reckoned_from_the_setpoints():
     ctl = pid()
 
@@ -150,11 +241,31 @@ def test_missing_attitude_is_dead_reckoned_from_the_setpoints():
     assert err.max() < 1.0
 
 
+@pytest.mark.parametrize("duration", [4.0, 15.0])
+def test_without_any_attitude_the_pointing_is_dead_reckoned_from_zero(duration):
+    """No attitude ever (pushes that never arrive): the loop still follows, dead-reckoning from
+    an assumed (0, 0); it once stayed idle. 15 s is more setpoints than the controller keeps."""
+    tr = run_scene(AttitudeFrom(math.inf), ramp, duration, tau=0.02)
+    assert set(tr.window("mode", 0.0)) == {"track"}
+    assert tr.window("err", 2.0).max() < 1.0
+
+
+@pytest.mark.parametrize("offset", [(30.0, 0.0), (-120.0, 0.0)])
+def test_the_first_measured_attitude_restarts_the_target_in_its_frame(offset):
+    """The first attitude replaces the assumed zero: the target's filter restarts in the measured
+    frame instead of seeing the whole difference as a jump of the target."""
+    late = run_scene(AttitudeFrom(1.5, offset), sine, 4.0, latency=0.05, noise_px=1.0)
+    measured = run_scene(pid(), sine, 4.0, latency=0.05, noise_px=1.0)
+    assert late.window("err", 1.5, 2.5).max() < 1.2 * measured.window("err", 1.5, 2.5).max()
+
+
 def test_config_validation_and_factory():
     with pytest.raises(ValueError):
         ControlConfig(max_speed_dps=400.0)
     with pytest.raises(ValueError):  # 120 deg/s to zero in 0.1 s needs 1200 deg/s^2
         ControlConfig(ramp_s=0.1, max_accel_dps2=900.0)
+    with pytest.raises(ValueError):
+        ControlConfig(setpoint_max_age_s=0.0)
     assert controller_names() == ["pid", "p"]
     assert isinstance(make_controller(camera=CAM), RateController)
     assert isinstance(make_controller("p", camera=CAM), ProportionalController)
