@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import can
 
-from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError, ReturnCodeError
+from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError, ReturnCodeError, SendError
 from gimbal.framer import Dropped
 from gimbal.messages import (Message, PayloadError, Reply, decode_message, is_device_push,
                              message_packet, reply_key)
@@ -390,7 +390,7 @@ class GimbalClient:
             try:
                 self.transport.send(raw)
             except (can.CanError, OSError) as exc:  # third-party interfaces may raise plain OSErrors
-                raise BusError(f"CAN send failed: {exc}") from exc
+                raise SendError(f"CAN send failed: {exc}") from exc
 
     def submit(self, message: Message, *, cmd_type: int | None = None) -> PendingReply:
         """Send a command that wants a reply and return at once; collect it with ``result``

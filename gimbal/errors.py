@@ -65,3 +65,7 @@ class GimbalTimeoutError(GimbalError, TimeoutError):
 
 class BusError(GimbalError):
     """The CAN bus failed or went away."""
+
+
+class SendError(BusError):
+    """The bus refused to send a frame (e.g. a full transmit queue: ENOBUFS on socketcan)."""

@@ -20,13 +20,13 @@ from dataclasses import dataclass
 import can
 
 from gimbal.client import DEFAULT_MAX_AGE_S, SPEED_HOLD, GimbalClient, PendingReply
-from gimbal.errors import BusError, GimbalError, RangeError
+from gimbal.errors import BusError, GimbalError, RangeError, SendError
 from gimbal.messages.motion import SpeedControl, to_raw
 
 log = logging.getLogger(__name__)
 
 MAX_SPEED_DPS = 360.0
-STAT_KEYS = ("sent", "zero_sent", "replies", "reply_errors", "reply_timeouts")  # in stats from the start
+STAT_KEYS = ("sent", "zero_sent", "replies", "reply_errors", "reply_timeouts", "send_errors")  # from the start
 MIN_RATE_HZ = 4.0  # at least two sends inside the gimbal's 0.5 s window
 MAX_RATE_HZ = 50.0  # public drivers use 10-50 Hz; a new setpoint may go out at twice the rate, and
 # each reply (a few ms) must be back by the next send, half a period later at the least
@@ -52,10 +52,11 @@ class SpeedStreamer:
     """Streams the latest yaw/pitch/roll speed setpoint at ``rate_hz``.
 
     A setpoint older than ``max_age`` seconds (since ``set()``, on ``clock``) is never resent:
-    zero speed goes out instead, so a stalled tracker stops the gimbal. Reply errors and timeouts
-    are counted in ``stats``; a refused send (``can.CanError``) or ``max_missed_replies``
-    consecutive reply timeouts mean the bus (or gimbal) is lost: streaming stops, a best-effort
-    stop is sent, ``error`` is set and the next ``set()`` raises ``BusError``.
+    zero speed goes out instead, so a stalled tracker stops the gimbal. Reply errors, reply
+    timeouts and sends the bus refused (a full transmit queue) are counted in ``stats``;
+    ``max_missed_replies`` consecutive speed commands without a reply, timed out or not sent,
+    mean the bus (or gimbal) is lost: streaming stops, a best-effort stop is sent, ``error`` is
+    set and the next ``set()`` raises ``BusError``.
     """
 
     def __init__(self, client: GimbalClient, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S, *,
@@ -159,7 +160,7 @@ class SpeedStreamer:
             if pending is not None:
                 self._client.cancel(pending)
 
-    def _tick(self) -> PendingReply:
+    def _tick(self) -> PendingReply | None:
         now = self._clock()
         with self._lock:
             setpoint = self._setpoint
@@ -169,7 +170,12 @@ class SpeedStreamer:
             message = SpeedControl(setpoint.yaw, setpoint.roll, setpoint.pitch, SPEED_HOLD)
         else:
             message = SpeedControl(0, 0, 0, SPEED_HOLD)
-        pending = self._client.submit(message)
+        try:
+            pending = self._client.submit(message)
+        except SendError as exc:  # often passing (a full transmit queue): counted like a lost reply
+            self.stats["send_errors"] += 1
+            self._count_miss(f"not sent: {exc}")
+            return None
         self.stats["sent"] += 1
         if not fresh:
             self.stats["zero_sent"] += 1
@@ -179,6 +185,13 @@ class SpeedStreamer:
                 self._latencies.append(self._clock() - setpoint.stamp)
         return pending
 
+    def _count_miss(self, what: str) -> None:
+        """One more speed command in a row without a reply; ``max_missed_replies`` = bus lost."""
+        self._missed += 1
+        log.warning("speed command %s (%d in a row)", what, self._missed)
+        if self._missed >= self.max_missed_replies:
+            raise BusError(f"no reply to {self._missed} consecutive speed commands (the last one {what})")
+
     def _collect(self, pending: PendingReply | None) -> None:
         """Account for the previous tick's reply; too many missing in a row = bus lost."""
         if pending is None:
@@ -186,10 +199,7 @@ class SpeedStreamer:
         self._client.cancel(pending)
         if not pending.done:
             self.stats["reply_timeouts"] += 1
-            self._missed += 1
-            log.warning("speed command: no reply before the next one (%d in a row)", self._missed)
-            if self._missed >= self.max_missed_replies:
-                raise BusError(f"no reply to {self._missed} consecutive speed commands")
+            self._count_miss("timed out")
             return
         self._missed = 0
         try:

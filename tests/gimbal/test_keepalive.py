@@ -136,7 +136,26 @@ def test_consecutive_reply_timeouts_mean_the_gimbal_is_lost(client: GimbalClient
     poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])  # the best-effort stop went out
 
 
-def test_a_refused_send_stops_streaming(channel: str, peer: ScriptedPeer) -> None:
+def test_a_send_refused_now_and_then_is_counted_and_streaming_goes_on(channel: str, peer: ScriptedPeer) -> None:
+    """One refused send (a full transmit queue: ENOBUFS on socketcan) once ended streaming for good."""
+    peer.answer(SpeedControl)
+    bus = FlakyBus(channel=channel)
+    with GimbalClient(bus) as gimbal:
+        streamer = gimbal.speed_streamer(rate_hz=25)
+        streamer.set(3, 3)
+        peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 30)
+        bus.fail_send = True
+        poll(lambda: streamer.stats["send_errors"] >= 2)
+        bus.fail_send = False
+        replies = streamer.stats["replies"]
+        poll(lambda: streamer.stats["replies"] > replies + 2)
+        streamer.set(4, 3)  # still streaming
+        assert streamer.error is None
+    assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
+    bus.shutdown()
+
+
+def test_a_bus_that_keeps_refusing_stops_streaming(channel: str, peer: ScriptedPeer) -> None:
     bus = FlakyBus(channel=channel)
     with GimbalClient(bus) as gimbal:
         streamer = gimbal.speed_streamer()
