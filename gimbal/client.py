@@ -58,6 +58,7 @@ log = logging.getLogger(__name__)
 
 FIRST_SEQ = 0x1122  # DJI's demo starts here
 RX_POLL_S = 0.05  # how often the receive thread looks at the closing flag
+RX_GIVE_UP_S = 0.25  # receive errors for this long, without a frame between, mean the bus is lost
 ECHO_EVIDENCE = 3  # replies in a row paired only by command that show the gimbal does not echo SEQs
 MAX_TIMEOUT = threading.TIMEOUT_MAX  # longer waits overflow the platform's time_t
 ANGLE_KINDS = {"attitude": ANGLES_ATTITUDE, "joint": ANGLES_JOINT}
@@ -280,7 +281,7 @@ class GimbalClient:
     def _receive_loop(self) -> None:
         try:
             while not self._closing.is_set():
-                item = self.transport.recv(RX_POLL_S)
+                item = self._receive()
                 if isinstance(item, Dropped):
                     self.stats[f"dropped_{item.reason}"] += len(item.data)
                     log.debug("dropped %d bytes (%s)", len(item.data), item.reason)
@@ -294,6 +295,22 @@ class GimbalClient:
             self._fail_all(exc)
             self.pushes.interrupt(BusError(f"the receive thread stopped: {exc}"))
             self._on_bus_lost()
+
+    def _receive(self) -> Packet | Dropped | None:
+        """The next packet; a bus that fails to receive is tried again until ``RX_GIVE_UP_S`` of
+        errors in a row (a passing error must not end a session), then its error is raised."""
+        failing_since: float | None = None
+        while True:
+            try:
+                return self.transport.recv(RX_POLL_S)
+            except (can.CanError, OSError) as exc:
+                now = time.monotonic()
+                failing_since = now if failing_since is None else failing_since
+                if now - failing_since >= RX_GIVE_UP_S or self._closing.is_set():
+                    raise
+                self.stats["receive_errors"] += 1
+                log.warning("CAN receive failed, trying again: %s", exc)
+                self._closing.wait(RX_POLL_S)
 
     def _on_bus_lost(self) -> None:
         streamer = self._streamer

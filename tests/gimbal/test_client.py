@@ -333,6 +333,18 @@ def test_a_dead_receive_thread_is_raised_on_the_next_call_and_stops_the_gimbal(
     bus.shutdown()
 
 
+def test_a_receive_error_that_passes_does_not_lose_the_bus(channel: str, peer: ScriptedPeer) -> None:
+    """One failed receive once marked the bus lost for good, though it worked again at once."""
+    bus = FlakyBus(channel=channel)
+    peer.answer(GetAngles, AnglesReply(0, 1, 10, 20, 30))
+    with GimbalClient(bus, timeout=0.2) as gimbal:
+        bus.fail_recv = True
+        poll(lambda: gimbal.stats["receive_errors"] >= 1)
+        bus.fail_recv = False
+        assert gimbal.alive and gimbal.get_angles().yaw == 1.0
+    bus.shutdown()
+
+
 def test_leaving_the_client_stops_and_releases_speed_control(client: GimbalClient,
                                                              peer: ScriptedPeer) -> None:
     peer.answer(SpeedControl)
