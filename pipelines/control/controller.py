@@ -261,10 +261,20 @@ class RateController:
         gimbal = self._pointing(t_act)
         e_yaw, e_pitch = wrap_deg(target[0] - gimbal[0]), target[1] - gimbal[1]
         self._yaw_unwrapped += wrap_deg(gimbal[0] - self._yaw_unwrapped)
-        ff = w * c.feedforward
-        yaw = ff * d.yaw_rate + self._pid_yaw(self._shaped(e_yaw), dt, measurement=self._yaw_unwrapped)
-        pitch = ff * d.pitch_rate + self._pid_pitch(self._shaped(e_pitch), dt, measurement=gimbal[1])
+        ff_yaw, ff_pitch = w * c.feedforward * d.yaw_rate, w * c.feedforward * d.pitch_rate
+        yaw = ff_yaw + self._pid_yaw(self._shaped(e_yaw), dt, measurement=self._yaw_unwrapped,
+                                     bounds=self._reachable(self._last.yaw_dps, dt, ff_yaw))
+        pitch = ff_pitch + self._pid_pitch(self._shaped(e_pitch), dt, measurement=gimbal[1],
+                                           bounds=self._reachable(self._last.pitch_dps, dt, ff_pitch))
         return self._emit(yaw, pitch, mode, dt, estimate, now, (e_yaw, e_pitch))
+
+    def _reachable(self, last: float, dt: float, offset: float) -> tuple[float, float]:
+        """The range the PID's share of a setpoint can take this step (the speed and acceleration
+        limits ``_emit`` applies, less ``offset``, the feed-forward), so it does not integrate what
+        the limits hold back."""
+        c = self.config
+        speed, step = min(c.max_speed_dps, PROTOCOL_MAX_SPEED_DPS), c.max_accel_dps2 * dt
+        return max(-speed, last - step) - offset, min(speed, last + step) - offset
 
     def _shaped(self, error: float) -> float:
         """The error the PID sees: unchanged while kp * |error| <= sqrt(2 * brake * |error|),

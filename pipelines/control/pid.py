@@ -18,7 +18,9 @@ class Pid:
     - ``deadband``: errors within +-deadband count as zero; outside it the deadband is subtracted,
       so the output stays continuous at its edge.
     - Integral: held as its contribution to the output, clamped to +-``integral_limit``, and not
-      grown while the output is saturated in the direction of the error (conditional integration).
+      grown while the output is saturated in the direction of the error (conditional integration),
+      at ``output_limit`` or at the ``bounds`` a call gives (what a limiter after the PID will let
+      through this step, e.g. an acceleration limit: integrating what it holds back winds up).
     - Derivative: on the measurement when one is given (no kick on setpoint steps; the measurement
       is the controlled variable, error = setpoint - measurement), otherwise on the error.
       Zero on the first call.
@@ -45,7 +47,8 @@ class Pid:
         self._last_error: float | None = None
         self._last_measurement: float | None = None
 
-    def __call__(self, error: float, dt: float, measurement: float | None = None) -> float:
+    def __call__(self, error: float, dt: float, measurement: float | None = None,
+                 bounds: tuple[float, float] | None = None) -> float:
         if not dt > 0.0:
             raise ValueError(f"dt must be positive, got {dt}")
         e = math.copysign(max(abs(error) - self.deadband, 0.0), error)
@@ -60,12 +63,16 @@ class Pid:
         p, d = self.kp * e, self.kd * rate
         integral = clamp(self.integral + self.ki * e * dt, self.integral_limit)
         raw = p + integral + d
-        limited = clamp(raw, self.output_limit)
+        limited = self._limit(raw, bounds)
         if limited != raw and e * (raw - limited) > 0.0 and abs(integral) > abs(self.integral):
             integral = self.integral  # saturated: do not wind further in the error's direction
-            limited = clamp(p + integral + d, self.output_limit)
+            limited = self._limit(p + integral + d, bounds)
         self.integral = integral
 
         step = self.slew_rate * dt
         self.output = self.output + clamp(limited - self.output, step)
         return self.output
+
+    def _limit(self, value: float, bounds: tuple[float, float] | None) -> float:
+        value = clamp(value, self.output_limit)
+        return value if bounds is None else min(max(value, bounds[0]), bounds[1])

@@ -81,3 +81,16 @@ def test_nan_is_refused_not_clamped_to_the_limit():
     with pytest.raises(ValueError):
         Pid(1.0, 1.0, output_limit=10.0)(float("nan"), 0.1)
     assert limit_rate(20.0, float("nan"), 100.0, 100.0, 0.1) == pytest.approx(10.0)  # towards 0
+
+
+def test_no_windup_against_bounds_a_later_limiter_sets():
+    """The controller's acceleration limit sits after the PID: the integral once grew while it held
+    the command back (0.9-1.8 deg/s left after a step or a stall, a slowly decaying offset)."""
+    pid = Pid(kp=1.0, ki=2.0, output_limit=100.0)
+    for _ in range(50):
+        out = pid(10.0, 0.02, bounds=(-5.0, 5.0))
+    assert out == 5.0 and pid.integral == 0.0
+    free = Pid(kp=1.0, ki=2.0, output_limit=100.0)
+    for _ in range(50):
+        free(10.0, 0.02)
+    assert free.integral == pytest.approx(20.0)
