@@ -44,18 +44,19 @@ def exit_on_signals(signals: Iterable[int] = TERMINATING_SIGNALS) -> Iterator[No
 
 @contextmanager
 def deferred_signals(signals: Iterable[int] = (signal.SIGINT, *TERMINATING_SIGNALS),
-                     deliver: bool = True) -> Iterator[None]:
+                     deliver: bool = True) -> Iterator[list[int]]:
     """Hold the given signals until the block ends, then deliver them to the handlers in place
     before it, so a unit of work (one frame and its outputs) is done whole or not at all; with
     ``deliver=False`` they are dropped instead (for the clean-up after a stop was already asked
-    for: a second Ctrl-C must not cut it short). Outside the main thread it changes nothing."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
+    for: a second Ctrl-C must not cut it short). Yields the list of signals held so far: clearing
+    it drops them. Outside the main thread it changes nothing."""
     pending: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield pending
+        return
     previous = {s: signal.signal(s, lambda signum, frame: pending.append(signum)) for s in signals}
     try:
-        yield
+        yield pending
     finally:
         for s, old in previous.items():
             signal.signal(s, old)

@@ -155,7 +155,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
         with open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
-            held.enter_context(deferred_signals())
+            pending_signals = held.enter_context(deferred_signals())
             make_out_dir(options.out_dir)
             can_log = _can_log(options.out_dir / "can.log")
             try:
@@ -164,7 +164,11 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                     where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
                              " ".join(str(v) for v in (args.interface or "python-can's configured bus",
                                                        args.channel) if v))
-                    session = _session(options, source, client, where, can_log, held)
+                    try:
+                        session = _session(options, source, client, where, can_log, held)
+                    except CliError:  # it says why the run ended; a signal held meanwhile adds nothing
+                        pending_signals.clear()
+                        raise
                     return _run(session, args)
             finally:
                 can_log.stop()

@@ -147,15 +147,18 @@ class RateController:
         self._last = RateCommand(0.0, 0.0)
 
     def _take_attitude(self, attitude: tuple[float, float] | None, frame_t: float, captured: bool) -> bool:
-        """Set the pointing reference: the measured ``attitude`` at ``frame_t``, else dead-reckoned
-        (moved up to each frame's capture time, so the setpoints before it are no longer needed),
-        starting from an assumed (0, 0) until an attitude is measured. True when a measured
-        attitude replaces the assumed one: the world frame has changed."""
+        """Set the pointing reference: the measured ``attitude`` at ``frame_t``; else, once one was
+        measured, dead-reckoned (moved up to each frame's capture time, so the setpoints before it
+        are no longer needed); before any, (0, 0) at each frame's capture: the loop then works in
+        the camera's frame, as without attitude feedback (dead-reckoning from an unknown start
+        grew without bound against a gimbal at its stop, and past 90 deg of pitch turned the
+        commands round). True when a measured attitude replaces the assumed one: the world frame
+        has changed."""
         if attitude is not None:
             reframed = self._assumed
             self._attitude, self._assumed = (attitude[0], attitude[1], frame_t), False
             return reframed
-        if self._attitude is None:
+        if self._attitude is None or (self._assumed and captured):
             self._attitude, self._assumed = (0.0, 0.0, frame_t), True
         elif captured and frame_t > self._attitude[2]:
             self._attitude = (*self._pointing(frame_t), frame_t)
@@ -177,11 +180,12 @@ class RateController:
 
     def _integrate_sent(self, t0: float, t1: float) -> tuple[float, float]:
         """Angle (yaw, pitch) swept by the setpoints sent between times t0 and t1 (each one holds
-        until the next; they are sent in time order, so the walk back stops at the one before t0)."""
+        until the next, or until the keep-alive replaces it by zero; they are sent in time order,
+        so the walk back stops at the one before t0)."""
         dyaw = dpitch = 0.0
         end = t1
         for t, yaw, pitch in reversed(self._sent):
-            span = min(end, t1) - max(t, t0)
+            span = min(end, t1, t + self.config.setpoint_max_age_s) - max(t, t0)
             if span > 0:
                 dyaw += yaw * span
                 dpitch += pitch * span

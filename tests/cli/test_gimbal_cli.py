@@ -117,6 +117,13 @@ def test_speed_streams_then_stops_and_releases(channel: str, peer: ScriptedPeer,
     assert json.loads(capsys.readouterr().out)["reply_timeouts"] == 0
 
 
+@pytest.mark.parametrize("duration", ["0", "0.05"])
+def test_speed_too_short_to_see_a_reply_is_not_a_failure(channel: str, peer: ScriptedPeer, duration: str) -> None:
+    """A run whose one reply was not collected yet once exited 1: 'did not answer of 1'."""
+    peer.answer(SpeedControl)
+    assert gimbal(channel, "speed", "--yaw", "5", "--duration", duration) == 0
+
+
 @pytest.mark.parametrize("answer", ["nack", "silence"])
 def test_speed_refused_or_unanswered_is_a_one_line_error(channel: str, peer: ScriptedPeer, answer: str,
                                                          capsys: pytest.CaptureFixture[str]) -> None:

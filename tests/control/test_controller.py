@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from control_scene import run_scene
+from pipelines.control.direction import relative
 from pipelines.control.camera import CameraModel
 from pipelines.control.controller import (
     ControlConfig, ProportionalController, RateController, controller_names, make_controller,
@@ -242,12 +243,41 @@ def test_missing_attitude_is_dead_reckoned_from_the_setpoints():
 
 
 @pytest.mark.parametrize("duration", [4.0, 15.0])
-def test_without_any_attitude_the_pointing_is_dead_reckoned_from_zero(duration):
-    """No attitude ever (pushes that never arrive): the loop still follows, dead-reckoning from
-    an assumed (0, 0); it once stayed idle. 15 s is more setpoints than the controller keeps."""
+def test_without_any_attitude_the_loop_follows_in_the_cameras_frame(duration):
+    """No attitude ever (pushes that never arrive): the loop still follows, as without attitude
+    feedback (it once stayed idle), better than the P baseline."""
     tr = run_scene(AttitudeFrom(math.inf), ramp, duration, tau=0.02)
+    p_err = run_scene(baseline(), ramp, duration, tau=0.02).window("err", 2.0)
     assert set(tr.window("mode", 0.0)) == {"track"}
-    assert tr.window("err", 2.0).max() < 1.0
+    assert tr.window("err", 2.0).max() < 3.0 and tr.window("err", 2.0).mean() < 0.5 * p_err.mean()
+
+
+def test_without_any_attitude_a_gimbal_at_its_stop_is_never_turned_the_wrong_way():
+    """Dead-reckoning from an assumed (0, 0) once grew past 90 deg of pitch against a gimbal held at
+    its stop, and then sent the pitch the wrong way and spun the yaw for a subject straight ahead."""
+    controller = RateController(CAM)
+    yaw, pitch, subject = 0.0, 25.0, (0.0, 40.0)  # the gimbal stops at +35: the subject stays above
+    for i in range(240):
+        t = i / 30
+        x, y = CAM.angles_to_pixel(*relative((yaw, pitch), subject))
+        estimate = TargetEstimate((x - 20, y - 20, 40, 40), (0.0, 0.0), 1.0, TrackState.TRACKING, t, i)
+        command = controller.update(estimate, None, t + 0.03)
+        assert command.pitch_dps >= 0.0 and abs(command.yaw_dps) < 1e-6
+        yaw, pitch = yaw + command.yaw_dps / 30, min(35.0, pitch + command.pitch_dps / 30)
+
+
+def test_a_setpoint_the_keep_alive_has_zeroed_is_not_counted_in_the_pointing():
+    """After a frame stall the Smith predictor once took the last setpoint as held through the stall
+    (the keep-alive had sent zero after 0.3 s): a phantom error of ~10 deg on the first frame."""
+    controller = RateController(CAM)
+    for i in range(60):
+        t = i / 30
+        controller.update(TargetEstimate((310, 170, 20, 20), (0.0, 0.0), 1.0, TrackState.TRACKING, t, i),
+                          (60.0 * t, 0.0), t)
+    # one second later: the gimbal stopped at its last attitude, the subject is centred
+    after = controller.update(TargetEstimate((310, 170, 20, 20), (0.0, 0.0), 1.0, TrackState.TRACKING, 3.0, 60),
+                              (60.0 * 59 / 30 + 60.0 * 0.3, 0.0), 3.0)
+    assert abs(after.yaw_error_deg) < 1.0
 
 
 @pytest.mark.parametrize("offset", [(30.0, 0.0), (-120.0, 0.0)])

@@ -259,3 +259,15 @@ def test_an_output_that_fails_at_the_end_is_one_line_with_the_summary_saying_so(
     assert summary["status"] == "output failed" and summary["frames"] == 20
     assert "plot" not in summary["outputs"] and not (out / "plot.png").exists()
     assert_stopped_at_end(decoded(out / "can.log"))
+
+
+def test_a_setup_error_is_not_hidden_by_a_signal_held_meanwhile(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """The held SIGTERM once replaced the error: exit 143 and no word of what had failed."""
+    def broken(self, *args: object, **kwargs: object) -> None:
+        signal.raise_signal(signal.SIGTERM)
+        raise ValueError("cannot load the tracker model: no such file")
+
+    monkeypatch.setattr(pipelines.cli.track_cmd.TrackSession, "__init__", broken)
+    assert run_track(DEMO, tmp_path / "out", "--roi", DEMO_ROI, "--no-video") == 2
+    _one_line_error(capsys, "cannot load the tracker model")
