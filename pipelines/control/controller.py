@@ -111,7 +111,8 @@ class RateController:
     ``max_prediction_s`` past its frame and held there beyond; the gimbal's pointing at that same
     time is predicted from the attitude at frame time plus all the setpoints already sent (a Smith
     predictor), so pipeline latency does not destabilise the loop. Without a measured attitude
-    the pointing is dead-reckoned from the setpoints, from an assumed (0, 0) until one arrives.
+    the pointing is dead-reckoned from the setpoints once one has been measured; before any, the
+    loop works in the camera's frame (see ``_take_attitude``).
     The extrapolation and the feed-forward are scaled by a trust (:class:`PredictionTrust`):
     the share of the predicted motion that has been coming true over the time the loop needs
     to act and to reverse the target's speed at the acceleration limit. Smooth motion keeps it
@@ -138,7 +139,7 @@ class RateController:
         self._pid_yaw, self._pid_pitch = self._pid(), self._pid()
         self._direction: Direction | None = None
         self._attitude: tuple[float, float, float] | None = None  # yaw, pitch, time
-        self._assumed = False  # _attitude is dead-reckoned from an assumed (0, 0): none measured yet
+        self._assumed = False  # _attitude is the camera's frame, (0, 0) at capture: none measured yet
         self._sent: deque[tuple[float, float, float]] = deque(maxlen=256)  # time, yaw, pitch
         self._last_now: float | None = None
         self._last_good: float = -math.inf
@@ -207,8 +208,8 @@ class RateController:
         """One setpoint for the frame behind ``estimate`` (``None``: no frame or no detection).
 
         ``attitude`` is the gimbal (yaw, pitch) in degrees at the frame's capture time (at ``now``
-        without an estimate); when ``None`` it is dead-reckoned from the setpoints sent (from an
-        assumed (0, 0) if none was ever given).
+        without an estimate); when ``None`` it is dead-reckoned from the setpoints sent, or, if none
+        was ever given, taken as (0, 0) at each capture (the camera's frame).
         """
         c = self.config
         dt, from_rest = _time_step(c, self._last_now, now)
