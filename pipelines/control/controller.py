@@ -140,6 +140,7 @@ class RateController:
         self._direction: Direction | None = None
         self._attitude: tuple[float, float, float] | None = None  # yaw, pitch, time
         self._assumed = False  # _attitude is the camera's frame, (0, 0) at capture: none measured yet
+        self._reckoned = False  # frames since the last measured attitude were placed by dead-reckoning
         self._sent: deque[tuple[float, float, float]] = deque(maxlen=256)  # time, yaw, pitch
         self._last_now: float | None = None
         self._last_good: float = -math.inf
@@ -157,13 +158,28 @@ class RateController:
         has changed."""
         if attitude is not None:
             reframed = self._assumed
-            self._attitude, self._assumed = (attitude[0], attitude[1], frame_t), False
+            if self._reckoned:
+                self._correct_reckoning(attitude, frame_t)
+            self._attitude, self._assumed, self._reckoned = (attitude[0], attitude[1], frame_t), False, False
             return reframed
         if self._attitude is None or (self._assumed and captured):
             self._attitude, self._assumed = (0.0, 0.0, frame_t), True
-        elif captured and frame_t > self._attitude[2]:
+            return False
+        self._reckoned = True
+        if captured and frame_t > self._attitude[2]:
             self._attitude = (*self._pointing(frame_t), frame_t)
         return False
+
+    def _correct_reckoning(self, attitude: tuple[float, float], frame_t: float) -> None:
+        """The attitude is back after frames placed by dead-reckoning: the target was measured
+        against a pointing off by as much as the reckoning drifted, so move it by the same (the
+        correction would otherwise look like a jump of the target)."""
+        reckoned = self._pointing(frame_t)
+        dyaw, dpitch = wrap_deg(attitude[0] - reckoned[0]), attitude[1] - reckoned[1]
+        self._filter.shift(dyaw, dpitch)
+        self._trust.shift(dyaw, dpitch)
+        if self._direction is not None:
+            self._direction = self._direction.shifted(dyaw, dpitch)
 
     def _forget_target(self) -> None:
         """Start the target's filter, trust and PID afresh (a new acquisition, a new world frame)."""

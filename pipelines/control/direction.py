@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from filterpy.kalman import KalmanFilter
@@ -66,6 +66,10 @@ class Direction:
         dt = t - self.timestamp
         return wrap_deg(self.yaw + self.yaw_rate * dt), self.pitch + self.pitch_rate * dt
 
+    def shifted(self, dyaw: float, dpitch: float) -> Direction:
+        """The same direction moved by (``dyaw``, ``dpitch``) degrees."""
+        return replace(self, yaw=wrap_deg(self.yaw + dyaw), pitch=self.pitch + dpitch)
+
 
 class DirectionFilter:
     """Constant-velocity Kalman filter on (yaw, pitch); state ``[yaw, yaw', pitch, pitch']``.
@@ -84,6 +88,12 @@ class DirectionFilter:
 
     def reset(self) -> None:
         self._kf = None
+
+    def shift(self, dyaw: float, dpitch: float) -> None:
+        """Move the filtered direction by (``dyaw``, ``dpitch``): the frame it was measured in moved."""
+        if self._kf is not None:
+            self._kf.x[0] += dyaw
+            self._kf.x[2] += dpitch
 
     def _start(self, z: tuple[float, float], t: float) -> None:
         kf = KalmanFilter(dim_x=4, dim_z=2)
@@ -168,3 +178,7 @@ class PredictionTrust:
 
     def add(self, direction: Direction) -> None:
         self._history.append(direction)
+
+    def shift(self, dyaw: float, dpitch: float) -> None:
+        """Move the remembered directions by (``dyaw``, ``dpitch``), as :meth:`DirectionFilter.shift`."""
+        self._history = deque((d.shifted(dyaw, dpitch) for d in self._history), maxlen=self._history.maxlen)
