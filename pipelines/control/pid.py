@@ -48,7 +48,7 @@ class Pid:
         self._last_measurement: float | None = None
 
     def __call__(self, error: float, dt: float, measurement: float | None = None,
-                 bounds: tuple[float, float] | None = None) -> float:
+                 bounds: tuple[float, float] | None = None, integrate: bool = True) -> float:
         if not dt > 0.0:
             raise ValueError(f"dt must be positive, got {dt}")
         e = math.copysign(max(abs(error) - self.deadband, 0.0), error)
@@ -61,7 +61,7 @@ class Pid:
         self._last_error = e
 
         p, d = self.kp * e, self.kd * rate
-        integral = clamp(self.integral + self.ki * e * dt, self.integral_limit)
+        integral = clamp(self.integral + self.ki * e * dt, self.integral_limit) if integrate else self.integral
         raw = p + integral + d
         limited = self._limit(raw, bounds)
         if limited != raw and e * (raw - limited) > 0.0 and abs(integral) > abs(self.integral):

@@ -356,6 +356,15 @@ def test_large_step_closes_fast_without_overshoot():
     assert t[np.argmax(np.abs(yaw_err) < 1.0)] - 1.0 < 0.6  # within 1 deg in under 0.6 s
 
 
+@pytest.mark.parametrize("size", [10.0, 20.0])
+def test_the_integral_does_not_grow_while_a_large_step_closes_at_braking_speed(size):
+    """The shaper sets the closing speed of a large error; integrating it meanwhile overshot and
+    left a slowly decaying offset (20 deg: 0.18 deg over, -0.16 deg at 2-3 s; 10 deg: -0.11)."""
+    tr = run_scene(pid(), lambda t: (size if t >= 1.0 else 0.0, 0.0), 3.0)
+    assert -tr.window("yaw_err", 1.0).min() < 0.1
+    assert abs(tr.window("yaw_err", 2.0, 3.0).mean()) < 0.09
+
+
 def test_the_first_detection_is_acted_on_within_the_acceleration_limit():
     cfg = ControlConfig()
     est = TargetEstimate((500.0, 170.0, 20.0, 20.0), (0, 0), 0.9, TrackState.TRACKING, 0.0, 0)

@@ -94,3 +94,10 @@ def test_no_windup_against_bounds_a_later_limiter_sets():
     for _ in range(50):
         free(10.0, 0.02)
     assert free.integral == pytest.approx(20.0)
+
+
+def test_a_call_that_does_not_integrate_leaves_the_integral_alone():
+    pid = Pid(1.0, ki=2.0)
+    pid(1.0, 0.5)
+    assert pid(3.0, 0.5, integrate=False) == pytest.approx(3.0 + 1.0)
+    assert pid.integral == pytest.approx(1.0)
