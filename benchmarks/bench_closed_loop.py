@@ -36,6 +36,7 @@ from pipelines.virtual_camera import VirtualCamera
 from tracker.boxes import center
 from tracker.data_paths import shared_sequences
 from tracker.datasets import Sequence, load_sequence
+from tracker.metrics import has_truth
 
 LATENCIES_MS = (0, 100)
 CONTROLLERS = ("p", "pid")
@@ -60,23 +61,26 @@ def wide_sequences() -> list[Path]:
 
 
 def _truth_angles(path: Path) -> tuple[np.ndarray, float]:
-    """World (yaw, pitch) of the subject's centre per frame, and degrees -> diagonal fraction."""
+    """World (yaw, pitch) of the subject's centre per frame (NaN where the frame has no ground
+    truth), and degrees -> diagonal fraction."""
     seq, size = _load(path)
     vc = VirtualCamera(size)
-    angles = np.array([vc.source.pixel_to_angles(*center(box)) for box in seq.groundtruth])
+    angles = np.array([vc.source.pixel_to_angles(*center(box)) if has_truth(box) else (math.nan, math.nan)
+                       for box in seq.groundtruth])
     return angles, math.radians(1.0) * vc.camera.focal_px / vc.camera.diagonal_px
 
 
 def _prediction_rms(angles: np.ndarray, ahead: int, predictor: str, accel_std: float, fps: float) -> float:
-    """RMS error (deg) of predicting frame k from frames <= k - ahead (before any: the start, 0)."""
+    """RMS error (deg) of predicting frame k from frames <= k - ahead (before any: the start, 0),
+    over the frames with ground truth."""
     kf, errs, state = DirectionFilter(accel_std_dps2=accel_std), [], None
     for k in range(len(angles)):
-        if k - ahead >= 0:
+        if k - ahead >= 0 and not np.isnan(angles[k - ahead]).any():
             state = kf.update(tuple(angles[k - ahead]), (k - ahead) / fps)
         guess = (0.0, 0.0) if state is None else (
             (state.yaw, state.pitch) if predictor == "hold" else state.at(k / fps))
         errs.append(math.hypot(*(np.asarray(guess) - angles[k])))
-    return float(np.sqrt(np.mean(np.square(errs))))
+    return float(np.sqrt(np.nanmean(np.square(errs))))
 
 
 def _accel_bound(angles: np.ndarray, start_s: float, accel: float, fps: float, sub: int = 4) -> float:
@@ -89,6 +93,8 @@ def _accel_bound(angles: np.ndarray, start_s: float, accel: float, fps: float, s
         j = np.arange(k * sub)
         a[k, j] = h * (k / fps - (j + 0.5) * h)
     a[:, : round(start_s / h)] = 0.0
+    known = ~np.isnan(angles).any(axis=1)
+    a, angles = a[known], angles[known]
     err = [a @ lsq_linear(a, angles[:, i], bounds=(-accel, accel), method="bvls").x - angles[:, i]
            for i in (0, 1)]
     return float(np.sqrt(np.mean(np.square(err[0]) + np.square(err[1]))))
