@@ -20,7 +20,8 @@ class Pid:
     - Integral: held as its contribution to the output, clamped to +-``integral_limit``, and not
       grown while the output is saturated in the direction of the error (conditional integration),
       at ``output_limit`` or at the ``bounds`` a call gives (what a limiter after the PID will let
-      through this step, e.g. an acceleration limit: integrating what it holds back winds up).
+      through this step, e.g. an acceleration limit: integrating what it holds back winds up);
+      a call with ``integrate=False`` holds it (the caller knows the error is not a bias to remove).
     - Derivative: on the measurement when one is given (no kick on setpoint steps; the measurement
       is the controlled variable, error = setpoint - measurement), otherwise on the error.
       Zero on the first call.
