@@ -85,9 +85,9 @@ def run_sequence(tracker: Trackable, sequence: Sequence,
             tracker.init(frame, start, timestamp)
             boxes.append(start)
         else:
-            start, cpu_start = time.perf_counter(), time.process_time()
+            wall_start, cpu_start = time.perf_counter(), time.process_time()
             estimate = tracker.update(frame, timestamp)
-            elapsed += time.perf_counter() - start
+            elapsed += time.perf_counter() - wall_start
             cpu += time.process_time() - cpu_start
             boxes.append(boxes[-1] if estimate.state is TrackState.LOST else estimate.box)
         if progress is not None:

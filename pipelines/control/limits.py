@@ -10,7 +10,8 @@ PROTOCOL_MAX_SPEED_DPS = 360.0  # the DJI R SDK speed command range
 
 def limit_rate(previous: float, wanted: float, max_speed: float, max_accel: float, dt: float) -> float:
     """``wanted`` clamped to +-max_speed (and the protocol's 360 deg/s), moving at most
-    ``max_accel * dt`` from ``previous``. A NaN ``wanted`` is no setpoint at all: it counts as 0."""
+    ``max_accel * dt`` from ``previous``; the speed range wins when ``previous`` lies outside it.
+    A NaN ``wanted`` is no setpoint at all: it counts as 0."""
     if math.isnan(wanted):
         wanted = 0.0
     speed = min(max_speed, PROTOCOL_MAX_SPEED_DPS)
