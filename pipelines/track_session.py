@@ -319,8 +319,8 @@ class TrackSession:
         self._finalise("telemetry", self.telemetry.close)  # what was flushed before a failure is kept
         if self.video is not None:
             self._finalise("annotated video", self.video.close)
-        if self.series.t and not self._finalise("plot", self._write_plot):
-            del self.paths["plot"]
+        if not (self.series.t and self._finalise("plot", self._write_plot)):
+            del self.paths["plot"]  # a run that ended before its first frame has nothing to plot
         try:
             return self.write_summary()
         except OSError as exc:  # the previous rewrite, if any, stays in place

@@ -207,7 +207,9 @@ def test_a_gimbal_refusing_the_start_up_commands_is_one_line(
     out = tmp_path / "out"
     assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
     _one_line_error(capsys, "refused to start", "0x02")
-    assert json.loads((out / "summary.json").read_text())["status"] == "gimbal refused to start"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "gimbal refused to start"
+    assert all(Path(path).exists() for path in summary["outputs"].values())  # no plot listed without frames
 
 
 def test_a_recording_started_but_not_confirmed_is_still_stopped(
