@@ -1,0 +1,48 @@
+"""A subject that leaves the frame and comes back is found again by the detector, which runs only
+while there is no subject (acquiring, or lost): a detection that persists restarts the tracker."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import pipelines.track_session
+from pipelines.outputs.telemetry import read_telemetry
+from tests.track.helpers import SIZE, make_clip, run_track
+
+BACK_AT = 50  # the frame where the subject starts to come back in from the right
+
+
+def _position(i: int) -> tuple[int, int] | None:
+    if i < BACK_AT:
+        x = 140 + 6 * i
+        return (x, 100) if x < SIZE[0] else None  # out of view from frame 30 on
+    return SIZE[0] - 6 * (i - BACK_AT), 100
+
+
+def test_the_detector_runs_only_without_a_subject_and_finds_it_again(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    calls = {"detect": 0, "init": 0}
+    make_detector, make_tracker = pipelines.track_session.make_detector, pipelines.track_session.make_tracker
+
+    def counted(name: str, target: Any) -> Any:
+        real = getattr(target, name)
+
+        def call(*args: Any) -> Any:
+            calls[name] += 1
+            return real(*args)
+
+        setattr(target, name, call)
+        return target
+
+    monkeypatch.setattr(pipelines.track_session, "make_detector", lambda *a: counted("detect", make_detector(*a)))
+    monkeypatch.setattr(pipelines.track_session, "make_tracker", lambda *a: counted("init", make_tracker(*a)))
+    clip = make_clip(tmp_path / "back.avi", 90, _position)
+    assert run_track(clip, tmp_path / "out", "--detect", "motion", "--no-video") == 0
+    states = [r["state"] for r in read_telemetry(tmp_path / "out" / "telemetry.jsonl")]
+    lost = states.index("lost")
+    assert "tracking" in states[:lost] and lost < BACK_AT
+    assert calls["init"] == 2 and states[-1] == "tracking", "not found again"
+    # every frame without a subject, and the two frames whose detection started the tracker
+    assert calls["detect"] == states.count("acquiring") + states.count("lost") + calls["init"]
