@@ -320,7 +320,7 @@ class TrackSession:
         if self.video is not None:
             self._finalise("annotated video", self.video.close)
         if not (self.series.t and self._finalise("plot", self._write_plot)):
-            del self.paths["plot"]  # a run that ended before its first frame has nothing to plot
+            self.paths.pop("plot", None)  # a run that ended before its first frame has nothing to plot
         try:
             return self.write_summary()
         except OSError as exc:  # the previous rewrite, if any, stays in place
