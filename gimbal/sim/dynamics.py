@@ -97,8 +97,11 @@ class Axis:
         if allowed.wraps:
             self.angle = wrap180(self.angle)
             return
-        if self.angle > allowed.high or self.angle < allowed.low:
-            self.angle = min(allowed.high, max(allowed.low, self.angle))
-            self.velocity = 0.0
-            if self.mode is AxisMode.MOVE:
-                self.mode, self._move = AxisMode.HOLD, None
+        if allowed.low <= self.angle <= allowed.high:
+            return
+        if self.mode is AxisMode.MOVE and self._move is not None and allowed.low <= self._move[1] <= allowed.high:
+            return  # a move into the range (the pull-back after new limits) brings the axis there
+        self.angle = min(allowed.high, max(allowed.low, self.angle))
+        self.velocity = 0.0
+        if self.mode is AxisMode.MOVE:
+            self.mode, self._move = AxisMode.HOLD, None

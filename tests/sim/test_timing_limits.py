@@ -7,7 +7,7 @@ from collections import Counter
 import pytest
 
 from gimbal.errors import ReturnCodeError
-from gimbal.messages import external, motion, telemetry
+from gimbal.messages import external, motion, settings, telemetry
 from gimbal.sim import SimConfig
 from gimbal.sim.dynamics import Axis, AxisRange
 from gimbal.sim.model import GimbalModel
@@ -85,6 +85,17 @@ def test_speed_stops_at_the_limit_and_new_limits_pull_back(make_client) -> None:
     assert state.joint[2] == 45.0 and state.speeds[2] == 0.0
     client.set_angle_limits(pitch_max=10, pitch_min=55, yaw_max=179, yaw_min=179, roll_max=30, roll_min=30)
     assert wait_until(lambda: sim.state().joint[2] == 10.0, 1.0)
+
+
+def test_new_limits_pull_the_axis_back_at_the_recenter_speed() -> None:
+    """The axis moves back at 100 deg/s, as docs/simulator.md says; it once snapped to the new limit."""
+    model = GimbalModel(SimConfig(initial_joint_deg=(0.0, 0.0, 40.0)), 0.0)
+    model.handle(settings.SetAngleLimits(pitch_max=10, pitch_min=55, yaw_max=179, yaw_min=179,
+                                         roll_max=30, roll_min=30), 0.0)
+    model.advance(0.1)
+    assert model.joint()[2] == pytest.approx(30.0)
+    model.advance(0.3)
+    assert model.joint()[2] == pytest.approx(10.0)
 
 
 def test_mechanical_ranges_and_continuous_yaw() -> None:
