@@ -247,13 +247,19 @@ def test_a_signal_just_after_the_output_folder_appears_still_leaves_a_summary(
     assert summary["status"] == status and summary["frames"] == 0
 
 
-def test_an_output_that_fails_at_the_end_is_one_line_with_the_summary_saying_so(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
-    """A full disk once failed the plot (or the final summary) with a traceback after the last frame."""
+@pytest.fixture
+def plot_on_full_disk(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Writing the plot fails as on a full disk (the last output a run writes)."""
     def disk_full(*args: object, **kwargs: object) -> None:
         raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(pipelines.track_session, "write_timeseries_png", disk_full)
+
+
+@pytest.mark.usefixtures("plot_on_full_disk")
+def test_an_output_that_fails_at_the_end_is_one_line_with_the_summary_saying_so(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A full disk once failed the plot (or the final summary) with a traceback after the last frame."""
     out = tmp_path / "out"
     assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video", "--max-frames", "20") == 1
     _one_line_error(capsys, "plot: No space left on device", "the gimbal was told to stop")
@@ -273,3 +279,18 @@ def test_a_setup_error_is_not_hidden_by_a_signal_held_meanwhile(
     monkeypatch.setattr(pipelines.cli.track_cmd.TrackSession, "__init__", broken)
     assert run_track(DEMO, tmp_path / "out", "--roi", DEMO_ROI, "--no-video") == 2
     _one_line_error(capsys, "cannot load the tracker model")
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+@pytest.mark.usefixtures("plot_on_full_disk")
+def test_the_failure_that_ended_the_run_stays_in_the_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """On a full disk several outputs fail one after the other: the summary keeps the failure that
+    ended the run, not the last one met while finalising the others."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "can.log").symlink_to("/dev/full")  # full from the first frame on; the plot fails at the end
+    assert run_track(DEMO, out, "--roi", DEMO_ROI, "--no-video") == 1
+    assert "cannot write the CAN log" in capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "output failed" and "cannot write the CAN log" in summary["error"]
+    assert "plot" not in summary["outputs"]
