@@ -99,7 +99,7 @@ class Axis:
             return
         if allowed.low <= self.angle <= allowed.high:
             return
-        if self.mode is AxisMode.MOVE and self._move is not None and allowed.low <= self._move[1] <= allowed.high:
+        if self.mode is AxisMode.MOVE and self._move is not None and allowed.contains(self._move[1]):
             return  # a move into the range (the pull-back after new limits) brings the axis there
         self.angle = min(allowed.high, max(allowed.low, self.angle))
         self.velocity = 0.0
