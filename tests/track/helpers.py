@@ -47,6 +47,11 @@ def make_clip(path: Path, frames: int, position: Position, fps: float = 30.0) ->
     return write_clip(path, (image(i) for i in range(frames)), fps, "MJPG")
 
 
+def drifting(i: int) -> tuple[int, int]:
+    """A subject drifting right by a pixel a frame, left of and above the centre."""
+    return 140 + i, 100
+
+
 def roi_at(position: Position) -> str:
     x, y = position(0)  # type: ignore[misc]
     return f"{x},{y},{BOX},{BOX}"

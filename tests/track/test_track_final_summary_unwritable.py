@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 import pipelines.track_session
-from tests.track.helpers import assert_stopped_at_end, decoded, make_clip, roi_at, run_track
+from tests.track.helpers import assert_stopped_at_end, decoded, drifting, make_clip, roi_at, run_track
 
 
 def test_a_final_summary_that_cannot_be_written_is_one_line_and_exit_1(
@@ -24,12 +24,9 @@ def test_a_final_summary_that_cannot_be_written_is_one_line_and_exit_1(
 
     monkeypatch.setattr(pipelines.track_session, "write_summary", full_at_the_end)
 
-    def position(i: int) -> tuple[int, int]:
-        return 140 + i, 100
-
-    clip = make_clip(tmp_path / "clip.avi", 12, position)
+    clip = make_clip(tmp_path / "clip.avi", 12, drifting)
     out = tmp_path / "out"
-    assert run_track(clip, out, "--roi", roi_at(position), "--no-video") == 1
+    assert run_track(clip, out, "--roi", roi_at(drifting), "--no-video") == 1
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("gimbaltrack track: error:")
     assert "summary: No space left on device" in err and "the gimbal was told to stop" in err

@@ -12,13 +12,9 @@ import pytest
 
 from pipelines.outputs.telemetry import read_telemetry
 from pipelines.track_session import TrackSession
-from tests.track.helpers import assert_stopped_at_end, decoded, make_clip, roi_at, run_track
+from tests.track.helpers import assert_stopped_at_end, decoded, drifting, make_clip, roi_at, run_track
 
 FRAMES = 20
-
-
-def _position(i: int) -> tuple[int, int]:
-    return 140 + i, 100
 
 
 def _assert_stopped_by_the_session(out: Path, status: str, frames: int) -> dict[str, Any]:
@@ -33,7 +29,7 @@ def _assert_stopped_by_the_session(out: Path, status: str, frames: int) -> dict[
 
 def test_a_source_failing_mid_run_stops_the_gimbal_and_exits_1(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    video = cv2.VideoCapture(str(make_clip(tmp_path / "clip.avi", FRAMES, _position)))
+    video = cv2.VideoCapture(str(make_clip(tmp_path / "clip.avi", FRAMES, drifting)))
     folder = tmp_path / "frames"
     folder.mkdir()
     for i in range(FRAMES):
@@ -43,7 +39,7 @@ def test_a_source_failing_mid_run_stops_the_gimbal_and_exits_1(
             image = cv2.resize(image, (160, 120))
         cv2.imwrite(str(folder / f"{i:03d}.png"), image)
     out = tmp_path / "out"
-    assert run_track(folder, out, "--roi", roi_at(_position), "--no-video") == 1
+    assert run_track(folder, out, "--roi", roi_at(drifting), "--no-video") == 1
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("gimbaltrack track: error:")
     assert "012.png" in err and "outputs so far are in" in err
@@ -63,10 +59,10 @@ def test_a_crash_mid_run_stops_the_gimbal_and_keeps_the_outputs(
         return real(self, *args)
 
     monkeypatch.setattr(TrackSession, "_track", crash_on_the_eighth)
-    clip = make_clip(tmp_path / "clip.avi", FRAMES, _position)
+    clip = make_clip(tmp_path / "clip.avi", FRAMES, drifting)
     out = tmp_path / "out"
     with pytest.raises(RuntimeError, match="a bug"):  # a bug shows its traceback
-        run_track(clip, out, "--roi", roi_at(_position))
+        run_track(clip, out, "--roi", roi_at(drifting))
     summary = _assert_stopped_by_the_session(out, "failed", 7)
     assert summary["error"] == "RuntimeError('a bug')"
     assert (out / "plot.png").exists()

@@ -9,7 +9,7 @@ import pytest
 
 from gimbal.client import GimbalClient
 from gimbal.errors import ReturnCodeError
-from tests.track.helpers import assert_stopped_at_end, decoded, host_commands, make_clip, roi_at, run_track
+from tests.track.helpers import assert_stopped_at_end, decoded, drifting, host_commands, make_clip, roi_at, run_track
 
 
 def test_a_refused_record_start_is_reported_and_never_stopped(
@@ -19,12 +19,9 @@ def test_a_refused_record_start_is_reported_and_never_stopped(
 
     monkeypatch.setattr(GimbalClient, "start_recording", refuse)
 
-    def position(i: int) -> tuple[int, int]:
-        return 140 + i, 100
-
-    clip = make_clip(tmp_path / "clip.avi", 15, position)
+    clip = make_clip(tmp_path / "clip.avi", 15, drifting)
     out = tmp_path / "out"
-    assert run_track(clip, out, "--roi", roi_at(position), "--no-video", "--record") == 0
+    assert run_track(clip, out, "--roi", roi_at(drifting), "--no-video", "--record") == 0
     recording = json.loads((out / "summary.json").read_text())["recording"]
     assert recording == {"requested": True, "started": False, "error": str(ReturnCodeError("camera_action", 0x02))}
     assert f"recording: not started ({recording['error']})" in capsys.readouterr().out

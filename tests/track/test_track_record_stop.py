@@ -12,17 +12,13 @@ import pytest
 from gimbal.client import SPEED_RELEASE, GimbalClient
 from gimbal.messages.camera import CameraActionCode
 from pipelines.outputs.telemetry import read_telemetry
-from tests.track.helpers import assert_stopped_at_end, decoded, host_commands, make_clip, roi_at, run_track
-
-
-def _position(i: int) -> tuple[int, int]:
-    return 140 + i, 100
+from tests.track.helpers import assert_stopped_at_end, decoded, drifting, host_commands, make_clip, roi_at, run_track
 
 
 def test_the_record_stop_follows_the_gimbal_stop(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    clip = make_clip(tmp_path / "clip.avi", 12, _position)
+    clip = make_clip(tmp_path / "clip.avi", 12, drifting)
     out = tmp_path / "out"
-    assert run_track(clip, out, "--roi", roi_at(_position), "--no-video", "--record") == 0
+    assert run_track(clip, out, "--roi", roi_at(drifting), "--no-video", "--record") == 0
     assert "recording: started (confirmed), stopped (confirmed)" in capsys.readouterr().out
     sent = host_commands(decoded(out / "can.log"))
     names = [r["name"] for r in sent]
@@ -36,9 +32,9 @@ def test_the_record_stop_follows_the_gimbal_stop(tmp_path: Path, capsys: pytest.
 def test_a_camera_still_recording_after_the_stop_is_reported(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(GimbalClient, "camera_status", lambda self: True)  # it never stops
-    clip = make_clip(tmp_path / "clip.avi", 12, _position)
+    clip = make_clip(tmp_path / "clip.avi", 12, drifting)
     out = tmp_path / "out"
-    assert run_track(clip, out, "--roi", roi_at(_position), "--no-video", "--record") == 0
+    assert run_track(clip, out, "--roi", roi_at(drifting), "--no-video", "--record") == 0
     assert "recording: started (confirmed), stop NOT confirmed" in capsys.readouterr().out
     recording = json.loads((out / "summary.json").read_text())["recording"]
     assert recording["stopped"] is True and recording["stop_confirmed"] is False
@@ -50,9 +46,9 @@ def test_a_record_stop_failing_on_the_bus_still_finishes_the_run(
         raise OSError("Network is down")
 
     monkeypatch.setattr(GimbalClient, "stop_recording", unplugged)
-    clip = make_clip(tmp_path / "clip.avi", 12, _position)
+    clip = make_clip(tmp_path / "clip.avi", 12, drifting)
     out = tmp_path / "out"
-    assert run_track(clip, out, "--roi", roi_at(_position), "--record") == 0
+    assert run_track(clip, out, "--roi", roi_at(drifting), "--record") == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "end of source" and summary["frames"] == 12
     assert summary["recording"]["started"] is True and summary["recording"]["error"] == "Network is down"
