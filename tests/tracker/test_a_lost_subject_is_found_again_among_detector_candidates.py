@@ -1,0 +1,41 @@
+"""A subject tracker given a detector: once the subject is LOST, the detector's candidates are
+compared with its look, and the tracker restarts on the one that looks like it, even out of
+the template search's reach."""
+from __future__ import annotations
+
+import numpy as np
+
+from tests.tracker.scripted_backend import follow, scripted_tracker, wide_scene
+from tracker.boxes import iou
+from tracker.detectors import Detection
+from tracker.estimate import TrackState
+
+BEFORE, AFTER = (100.0, 220.0, 40.0, 40.0), (520.0, 220.0, 40.0, 40.0)  # 420 px apart: past max_reach
+ELSEWHERE = (300.0, 60.0, 40.0, 40.0)  # a patch of background
+GONE, BACK = 5, 21  # the subject is out of the picture on frames GONE..BACK - 1
+
+
+class _Candidates:
+    """A detector that proposes a patch of background and, when the subject is in view, the subject."""
+
+    def __init__(self) -> None:
+        self.subject_in_view = True
+
+    def detect(self, frame: np.ndarray) -> list[Detection]:
+        return [Detection(ELSEWHERE, 0.9)] + ([Detection(AFTER, 0.8)] if self.subject_in_view else [])
+
+
+def test_a_lost_subject_is_restarted_on_the_candidate_that_looks_like_it() -> None:
+    frames = wide_scene([BEFORE] * GONE + [None] * (BACK - GONE) + [AFTER] * 5)
+    detector = _Candidates()
+    subject, backend = scripted_tracker(lambda n, restarts: (BEFORE, 0.9) if n < GONE else
+                                        (AFTER, 0.9) if restarts else (None, 0.0), detector)
+    subject.init(frames[0], BEFORE, 0.0)
+    detector.subject_in_view = False
+    away = follow(subject, frames[1:BACK])
+    assert away[-1].state is TrackState.LOST
+    detector.subject_in_view = True
+    back = follow(subject, frames[BACK:], first=BACK)
+    assert backend.inits == [0, BACK]
+    assert all(e.state is TrackState.TRACKING for e in back)
+    assert iou(back[0].box, AFTER) > 0.9

@@ -1,0 +1,33 @@
+"""The subject's first box (``start_box``, used by ``SubjectTracker.init``): kept as given while it
+overlaps the frame by any amount, refused once it only touches an edge from outside or is not
+finite, and grown about its centre to 4 px a side when smaller."""
+from __future__ import annotations
+
+import pytest
+
+from tracker.boxes import Box, start_box
+
+WIDTH, HEIGHT = 320, 240
+
+
+@pytest.mark.parametrize("box", [(319.0, 10.0, 20.0, 20.0), (-19.0, 10.0, 20.0, 20.0),   # a pixel in, right / left
+                                 (10.0, 239.0, 20.0, 20.0), (10.0, -19.0, 20.0, 20.0)])  # bottom / top
+def test_a_box_overlapping_the_frame_by_a_pixel_is_kept_as_given(box: Box) -> None:
+    assert start_box(box, WIDTH, HEIGHT) == box
+
+
+@pytest.mark.parametrize("box", [(320.0, 10.0, 20.0, 20.0), (-20.0, 10.0, 20.0, 20.0),   # touching right / left
+                                 (10.0, 240.0, 20.0, 20.0), (10.0, -20.0, 20.0, 20.0)])  # bottom / top
+def test_a_box_only_touching_the_frame_from_outside_is_refused(box: Box) -> None:
+    with pytest.raises(ValueError, match="lies outside the 320x240 frame"):
+        start_box(box, WIDTH, HEIGHT)
+
+
+@pytest.mark.parametrize("box", [(float("nan"), 10.0, 20.0, 20.0), (10.0, 10.0, float("inf"), 20.0)])
+def test_a_box_that_is_not_finite_is_refused(box: Box) -> None:
+    with pytest.raises(ValueError, match="not finite"):
+        start_box(box, WIDTH, HEIGHT)
+
+
+def test_a_tiny_box_grows_about_its_centre_to_the_minimum_size() -> None:
+    assert start_box((100.0, 50.0, 1.0, 6.0), WIDTH, HEIGHT) == (98.5, 50.0, 4.0, 6.0)
