@@ -11,6 +11,9 @@ from typing import Any
 from pipelines.outputs._files import to_plain
 from tracker.estimate import TargetEstimate
 
+#: What ``json.dumps(..., separators=(",", ":"), allow_nan=False)`` builds on every call.
+_ENCODER = json.JSONEncoder(separators=(",", ":"), allow_nan=False)
+
 
 def estimate_fields(estimate: TargetEstimate) -> dict[str, Any]:
     """The tracker part of a telemetry record (keys as documented in docs/outputs.md); the frame's
@@ -33,7 +36,7 @@ class TelemetryWriter:
 
     def write(self, record: Mapping[str, Any]) -> None:
         """Write ``record`` (numpy values, enums and tuples allowed; NaN is written as null)."""
-        line = json.dumps(to_plain(record), separators=(",", ":"), allow_nan=False)
+        line = _ENCODER.encode(to_plain(record))
         try:
             self._file.write(line + "\n")
             self._file.flush()
