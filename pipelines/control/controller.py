@@ -200,9 +200,11 @@ class RateController:
         until the next, or until the keep-alive replaces it by zero; they are sent in time order,
         so the walk back stops at the one before t0)."""
         dyaw = dpitch = 0.0
-        end = t1
+        if t1 <= t0:  # no span can be positive: the pointing at the attitude's own time, every frame
+            return dyaw, dpitch
+        end, max_age = t1, self.config.setpoint_max_age_s
         for t, yaw, pitch in reversed(self._sent):
-            span = min(end, t1, t + self.config.setpoint_max_age_s) - max(t, t0)
+            span = min(end, t1, t + max_age) - max(t, t0)
             if span > 0:
                 dyaw += yaw * span
                 dpitch += pitch * span
