@@ -15,6 +15,10 @@ from tracker.estimate import TargetEstimate, TrackState
 from tracker.kalman import BoxKalman
 
 
+#: A backend's box narrower or lower than this is a failure, not a subject (``_usable``).
+MIN_BOX_PX = 1.0
+
+
 @dataclass(frozen=True)
 class TrackerSettings:
     """Global thresholds (the same for every sequence; chosen on synthetic and benchmark data)."""
@@ -136,10 +140,11 @@ class SubjectTracker:
 
 
 def _usable(box: Box | None, score: float) -> tuple[Box | None, float]:
-    """A backend's answer with a numerical failure (a non-finite or empty box, a NaN score)
-    turned into a miss, so it never reaches the Kalman filter or the gimbal's controller."""
+    """A backend's answer with a numerical failure (a non-finite box, one under a pixel wide or
+    high, a NaN score) turned into a miss, so it never reaches the Kalman filter or the gimbal's
+    controller."""
     if not math.isfinite(score):
         score = 0.0
-    if box is not None and not (all(math.isfinite(v) for v in box) and box[2] > 0 and box[3] > 0):
+    if box is not None and not (all(math.isfinite(v) for v in box) and box[2] >= MIN_BOX_PX and box[3] >= MIN_BOX_PX):
         return None, 0.0
     return box, score

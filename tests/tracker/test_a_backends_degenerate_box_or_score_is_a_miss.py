@@ -1,6 +1,6 @@
 """A backend's degenerate answer (an empty or sub-pixel box, a NaN score with a finite box) is a
-miss: no exception, a finite estimate with no confidence, and an empty box does not shrink the
-subject's box. (NaN and infinite boxes: test_subject_tracker.py.)"""
+miss: no exception, a finite estimate with no confidence, and an empty or sub-pixel box does not
+shrink the subject's box. (NaN and infinite boxes: test_subject_tracker.py.)"""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -38,6 +38,7 @@ def test_a_degenerate_answer_is_a_finite_miss(kind: str) -> None:
     assert estimates[-1].state is TrackState.TRACKING
 
 
-def test_an_empty_box_does_not_shrink_the_subjects_box() -> None:
-    during = _estimates(DEGENERATE["empty box"])[GLITCH[0] - 1:GLITCH[-1]]
+@pytest.mark.parametrize("kind", ["empty box", "sub-pixel box"])
+def test_a_degenerate_box_does_not_shrink_the_subjects_box(kind: str) -> None:
+    during = _estimates(DEGENERATE[kind])[GLITCH[0] - 1:GLITCH[-1]]
     assert np.ptp([e.box[2:] for e in during] + [SEQ.boxes[0][2:]], axis=0) == pytest.approx((0.0, 0.0), abs=0.5)
