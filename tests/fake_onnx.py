@@ -66,16 +66,25 @@ def backbone_bytes() -> bytes:
                   [_value_info("input", (1, CHANNELS, "h", "w"))], [_value_info("output", (1, CHANNELS, "fh", "fw"))])
 
 
-def head_bytes() -> bytes:
+def head_bytes(sure: bool = False) -> bytes:
     """A NanoTrack-shaped neck/head: ``input1`` (template features), ``input2`` (search features)
-    -> ``output1`` (1, 2, 16, 16) and ``output2`` (1, 4, 16, 16)."""
+    -> ``output1`` (1, 2, 16, 16) and ``output2`` (1, 4, 16, 16). ``sure``: the foreground logit is
+    the features' sum and the background's 0, so any lit crop scores ~1 everywhere (as NanoTrack's
+    foreground score stays near 1 on background), and every map point proposes a 64 px square
+    around itself."""
     rng = np.random.default_rng(0)
+    w_cls, w_loc = rng.normal(size=(2, CHANNELS, 1, 1)), rng.normal(size=(4, CHANNELS, 1, 1))
+    loc_inputs, weights = ["joint", "w_loc"], []
+    if sure:
+        w_cls = np.stack([np.zeros((CHANNELS, 1, 1)), np.ones((CHANNELS, 1, 1))])
+        w_loc = np.zeros_like(w_loc)
+        loc_inputs.append("b_loc")
+        weights.append(_initializer("b_loc", np.full(4, 32.0)))
     nodes = [_node("GlobalAveragePool", ["input1"], ["template"]),
              _node("Add", ["input2", "template"], ["joint"]),
              _node("Conv", ["joint", "w_cls"], ["output1"], kernel_shape=[1, 1]),
-             _node("Conv", ["joint", "w_loc"], ["output2"], kernel_shape=[1, 1])]
-    weights = [_initializer("w_cls", rng.normal(size=(2, CHANNELS, 1, 1))),
-               _initializer("w_loc", rng.normal(size=(4, CHANNELS, 1, 1)))]
+             _node("Conv", loc_inputs, ["output2"], kernel_shape=[1, 1])]
+    weights += [_initializer("w_cls", w_cls), _initializer("w_loc", w_loc)]
     return _model(nodes, [_value_info("input1", (1, CHANNELS, 8, 8)), _value_info("input2", (1, CHANNELS, 16, 16))],
                   [_value_info("output1", (1, 2, 16, 16)), _value_info("output2", (1, 4, 16, 16))], weights)
 

@@ -5,6 +5,12 @@ The two networks are NanoTrack's: a backbone (template 127 px -> 8x8 features, s
 box-side distances (left, top, right, bottom) from each map point, stride 16 px in the search
 crop. The post-processing is SiamBAN's: a penalty on changes of box size and aspect ratio, a
 cosine window favouring small motion, and a size learning rate scaled by the peak's score.
+
+The foreground score stays near 1 on background, so the backend's score is that score times the
+subject's likeness in the backbone's own features: the cosine similarity of the template's cells
+under the subject's box with the search features under the chosen box (cell 7.5 of the 16x16
+search features is the crop's centre, 3.5 of the 8x8 template's), relative to its running typical
+value. It reuses the features of the search already made: no extra network pass.
 """
 from __future__ import annotations
 
@@ -42,6 +48,13 @@ class NanoTrackParams:
     calibration_strength: float = 0.5
     calibration_shift: float = 0.15
     calibration_limits: tuple[float, float] = (0.7, 1.4)
+    # The score's likeness factor: the deep-feature likeness over its running typical value, which
+    # follows frames at likeness_learn_above of it or more at likeness_rate (as dcf's response peak),
+    # so it does not sink to the background's level; at likeness_full of the typical value or more the
+    # factor is 1 (the subject's own frame-to-frame scatter; at 1.0 it cost AUC, docs/tracker.md).
+    likeness_rate: float = 0.05
+    likeness_learn_above: float = 0.6
+    likeness_full: float = 0.75
 
 
 def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
@@ -166,6 +179,26 @@ def select_peak(score: np.ndarray, boxes: np.ndarray, target_size: np.ndarray, w
     return (int(row), int(col)), float(penalty[row, col])
 
 
+def sample_cells(features: np.ndarray, center: tuple[float, float], cells: tuple[int, int]) -> np.ndarray:
+    """The (C, rows, cols) block of a (C, H, W) feature map centred on ``center`` = (col, row), in cell
+    units (fractional: bilinear; clamped to the map), with ``cells`` = (cols, rows)."""
+    _, height, width = features.shape
+    cols, rows = cells
+    xs = np.clip(center[0] + np.arange(cols) - (cols - 1) / 2, 0, width - 1)
+    ys = np.clip(center[1] + np.arange(rows) - (rows - 1) / 2, 0, height - 1)
+    x0, y0 = np.minimum(xs.astype(int), width - 2), np.minimum(ys.astype(int), height - 2)
+    fx, fy = (xs - x0)[None, :], (ys - y0)[:, None]
+    top = features[:, y0][:, :, x0] * (1 - fx) + features[:, y0][:, :, x0 + 1] * fx
+    bottom = features[:, y0 + 1][:, :, x0] * (1 - fx) + features[:, y0 + 1][:, :, x0 + 1] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def cosine_likeness(a: np.ndarray, b: np.ndarray) -> float:
+    """The cosine similarity of two equally shaped feature blocks, clipped to 0..1 (0 when either is 0)."""
+    norm = float(np.linalg.norm(a) * np.linalg.norm(b))
+    return float(np.clip(np.vdot(a, b) / norm, 0.0, 1.0)) if norm > 0 else 0.0
+
+
 def crop_square(frame: np.ndarray, cx: float, cy: float, side: float, out: int,
                 fill: tuple[float, float, float]) -> np.ndarray:
     """The square of ``side`` image pixels centred on (cx, cy), resampled to ``out`` x ``out``.
@@ -177,15 +210,18 @@ def crop_square(frame: np.ndarray, cx: float, cy: float, side: float, out: int,
 
 @dataclass(frozen=True)
 class Peak:
-    """The chosen score-map point: box (cx, cy, w, h) in image pixels, its score and penalty."""
+    """The chosen score-map point: box (cx, cy, w, h) in image pixels, its score and penalty, and
+    the search features' likeness there to the subject's template features (0..1)."""
 
     box: tuple[float, float, float, float]
     score: float
     penalty: float
+    likeness: float
 
 
 class NanoTrackBackend:
-    """NanoTrack v2 (``TrackingBackend``): score = foreground probability of the chosen peak."""
+    """NanoTrack v2 (``TrackingBackend``): score = foreground probability of the chosen peak times
+    its deep-feature likeness to the subject relative to the likeness's running typical value."""
 
     def __init__(self, model_dir: str | Path | None, params: NanoTrackParams | None = None) -> None:
         self.name = "nanotrack"
@@ -198,6 +234,8 @@ class NanoTrackBackend:
         self._velocity = np.zeros(2)  # the centre's motion over the last frame, pixels
         self._calibration = np.ones(2)  # given size / the network's size for the subject (w, h)
         self._fill = (0.0, 0.0, 0.0)
+        self._subject_features = np.zeros((1, 1, 1), np.float32)  # the template's cells under the subject
+        self._typical_likeness = 0.0
         self._ready = False
 
     def init(self, frame: np.ndarray, box: Box) -> None:
@@ -206,8 +244,13 @@ class NanoTrackBackend:
         self._size = np.array([max(w, 1.0), max(h, 1.0)])
         self._velocity = np.zeros(2)
         self._fill = tuple(float(v) for v in cv2.mean(frame)[:3])
-        template = crop_square(frame, *self._center, self._context_side(), EXEMPLAR_SIZE, self._fill)
-        self._head.setInput(self._features(template), "input1")
+        side = self._context_side()
+        template = self._features(crop_square(frame, *self._center, side, EXEMPLAR_SIZE, self._fill))
+        self._head.setInput(template, "input1")
+        cells = np.clip(np.round(self._size * EXEMPLAR_SIZE / side / STRIDE), 1, TEMPLATE_FEATURES).astype(int)
+        middle = (TEMPLATE_FEATURES - 1) / 2
+        self._subject_features = sample_cells(template[0], (middle, middle), (int(cells[0]), int(cells[1])))
+        self._typical_likeness = 0.0
         self._ready = True
         self._calibration = self._measure_size_calibration(frame)
         self._size = self._size / self._calibration  # tracked in the network's own size
@@ -225,7 +268,8 @@ class NanoTrackBackend:
         self._center = center
         self._size = np.clip(size, MIN_SIZE, frame_size)
         (cx, cy), (w, h) = self._center, np.minimum(self._size * self._calibration, frame_size)
-        return from_center(float(cx), float(cy), float(w), float(h)), float(np.clip(peak.score, 0, 1))
+        score = np.clip(peak.score, 0, 1) * self._relative_likeness(peak.likeness)
+        return from_center(float(cx), float(cy), float(w), float(h)), float(score)
 
     @property
     def size_calibration(self) -> np.ndarray:
@@ -245,6 +289,20 @@ class NanoTrackBackend:
         log_ratio = np.mean(np.log(self._size / np.maximum(sizes, 1.0)), axis=0)
         return np.clip(np.exp(p.calibration_strength * log_ratio), *p.calibration_limits)
 
+    def _relative_likeness(self, likeness: float) -> float:
+        """The score's likeness factor, 0..1: ``likeness`` over its running typical value, divided by
+        ``likeness_full`` and capped at 1 (1 on the first frame). Only frames at ``likeness_learn_above``
+        of the typical value or more move it, as ``dcf`` does with its response peak, so it does not
+        sink to the background's level while the subject is gone."""
+        p = self.params
+        if self._typical_likeness <= 0.0:
+            self._typical_likeness = likeness
+        relative = float(np.clip(likeness / max(self._typical_likeness, 1e-6), 0.0, 1.0))
+        if relative >= p.likeness_learn_above:
+            rate = p.likeness_rate * relative
+            self._typical_likeness = (1 - rate) * self._typical_likeness + rate * likeness
+        return min(relative / p.likeness_full, 1.0)
+
     def _context_side(self) -> float:
         """Side of the template crop: the box padded by ``context_amount`` (w + h), squared."""
         w, h = self._size
@@ -261,12 +319,17 @@ class NanoTrackBackend:
     def _search(self, frame: np.ndarray, center: np.ndarray, side: float) -> Peak:
         """The best peak in the search crop of ``side`` image pixels centred on ``center``."""
         crop = crop_square(frame, *center, side, INSTANCE_SIZE, self._fill)
-        self._head.setInput(self._features(crop), "input2")
+        features = self._features(crop)
+        self._head.setInput(features, "input2")
         cls, loc = self._head.forward(["output1", "output2"])
         score = foreground_score(cls[0])
         boxes = decode_boxes(loc[0], self._offsets)
         scale = INSTANCE_SIZE / side  # crop pixels per image pixel
         (row, col), penalty = select_peak(score, boxes, self._size * scale, self._window, self.params)
-        bcx, bcy, bw, bh = boxes[:, row, col] / scale
-        box = (float(center[0] + bcx), float(center[1] + bcy), float(bw), float(bh))
-        return Peak(box, float(score[row, col]), penalty)
+        bcx, bcy, bw, bh = boxes[:, row, col]
+        middle = (SCORE_SIZE - 1) / 2  # the search features' cell at the crop's centre
+        cell = (middle + bcx / STRIDE, middle + bcy / STRIDE)
+        subject = self._subject_features
+        likeness = cosine_likeness(subject, sample_cells(features[0], cell, (subject.shape[2], subject.shape[1])))
+        box = (float(center[0] + bcx / scale), float(center[1] + bcy / scale), float(bw / scale), float(bh / scale))
+        return Peak(box, float(score[row, col]), penalty, likeness)

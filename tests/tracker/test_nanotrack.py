@@ -1,15 +1,20 @@
 """Our NanoTrack backend: the numpy post-processing on hand-made maps, and tracking with the models."""
+import itertools
+
 import cv2
 import numpy as np
 import pytest
 
+from tracker.appearance import AppearanceModel, cut_patch
 from tracker.boxes import iou
+from tracker.datasets import load_sequence
+from tracker.estimate import TrackState
 from tracker.metrics import success_auc
 from tests import fake_onnx
 from tracker.backends import make_backend
-from tracker.nanotrack import (SCORE_SIZE, NanoTrackBackend, NanoTrackParams, change_penalty, crop_square,
-                               decode_boxes, foreground_score, grid_offsets, hanning_window,
-                               load_nanotrack_networks, select_peak)
+from tracker.nanotrack import (SCORE_SIZE, NanoTrackBackend, NanoTrackParams, change_penalty, cosine_likeness,
+                               crop_square, decode_boxes, foreground_score, grid_offsets, hanning_window,
+                               load_nanotrack_networks, sample_cells, select_peak)
 from tracker.subject import SubjectTracker
 from tracker.synthetic import render_sequence
 
@@ -183,3 +188,94 @@ def test_size_calibration_is_clipped_and_off_at_zero_strength(shared_data):
     off = NanoTrackBackend(shared_data / "models", NanoTrackParams(calibration_strength=0.0))
     off.init(seq.frames[0], seq.boxes[0])
     assert np.array_equal(off.size_calibration, np.ones(2))
+
+
+def test_sample_cells_interpolates_between_cells_and_clamps_at_the_border():
+    features = np.arange(2 * 4 * 4, dtype=np.float32).reshape(2, 4, 4)
+    assert np.array_equal(sample_cells(features, (1.5, 1.5), (2, 2)), features[:, 1:3, 1:3])
+    assert np.allclose(sample_cells(features, (1.0, 2.0), (1, 1))[:, 0, 0], features[:, 2, 1])
+    assert np.allclose(sample_cells(features, (1.25, 2.0), (1, 1))[:, 0, 0], features[:, 2, 1] + 0.25)
+    assert np.array_equal(sample_cells(features, (-3.0, 9.0), (1, 1))[:, 0, 0], features[:, 3, 0])
+
+
+def test_cosine_likeness_is_one_for_the_same_look_and_zero_for_opposite_or_empty_ones():
+    block = np.random.default_rng(0).normal(size=(3, 2, 2))
+    assert cosine_likeness(block, 2.0 * block) == pytest.approx(1.0)
+    assert cosine_likeness(block, -block) == 0.0
+    assert cosine_likeness(block, np.zeros_like(block)) == 0.0
+
+
+def _frame(shared_data, name: str, index: int) -> tuple[np.ndarray, tuple[float, ...]]:
+    """Frame ``index`` of a shared sequence and its true box."""
+    sequence = load_sequence(shared_data / "sequences" / name)
+    return next(itertools.islice(sequence.frames(), index, None)), sequence.groundtruth[index]
+
+
+def _lookalike_occlusion(shared_data, frames: int = 100, side: int = 48, hidden: tuple[int, int] = (30, 60)):
+    """Real footage rendered into a clip: a face (otb_girl's) moving right at 3 px a frame over a sea
+    (otb_surfer), hidden behind a patch of vot_bag for 30 frames while it moves on, past the four
+    patches of other footage most like it to pixel NCC within 0.35-0.55. Returns the frames, the
+    true boxes and which frames the face is fully hidden in."""
+    sea = cv2.resize(_frame(shared_data, "otb_surfer", 10)[0], (400, 300), interpolation=cv2.INTER_AREA)
+    girl, box = _frame(shared_data, "otb_girl", 0)
+    x, y, w, h = (round(v) for v in box)
+    face = cv2.resize(cv2.getRectSubPix(girl, (max(w, h),) * 2, (x + w // 2, y + h // 2)), (side, side))
+    look = AppearanceModel(face, (0, 0, side, side))
+    rng = np.random.default_rng(0)
+    alikes = []
+    for name, index in (("vot_bag", 50), ("otb_crossing", 30), ("vot15_ball1", 20), ("otb_girl", 250)):
+        image = _frame(shared_data, name, index)[0]
+        for _ in range(400):
+            size = int(rng.uniform(0.5, 1.5) * min(image.shape[:2]) / 4)
+            px, py = rng.integers(0, image.shape[1] - size), rng.integers(0, image.shape[0] - size)
+            patch = cv2.resize(image[py:py + size, px:px + size], (side, side), interpolation=cv2.INTER_AREA)
+            likeness = look.similarity(cut_patch(patch, (0, 0, side, side)))
+            if 0.35 <= likeness <= 0.55:
+                alikes.append((likeness, patch))
+    alikes.sort(key=lambda found: -found[0])
+    boxes = [(40.0 + 3.0 * i, 126.0 + 25.0 * np.sin(i / 15.0), float(side), float(side)) for i in range(frames)]
+    x_hidden = boxes[hidden[0]][0]
+    for (_, patch), (dx, dy) in zip(alikes, ((0.3, -1.5), (0.3, 1.5), (1.6, -1.5), (1.6, 1.5))):
+        px, py = int(x_hidden + dx * side), int(126 + dy * side)
+        sea[py:py + side, px:px + side] = patch
+    inside = boxes[hidden[0]:hidden[1]]
+    x0, x1 = int(min(b[0] for b in inside)) - 4, int(max(b[0] for b in inside)) + side + 4
+    y0, y1 = int(min(b[1] for b in inside)) - 4, int(max(b[1] for b in inside)) + side + 4
+    cover = cv2.resize(_frame(shared_data, "vot_bag", 150)[0], (400, 300))[y0:y1, x0:x1]
+    images = []
+    for bx, by, _, _ in boxes:
+        image = sea.copy()
+        image[round(by):round(by) + side, round(bx):round(bx) + side] = face
+        image[y0:y1, x0:x1] = cover
+        images.append(image)
+    fully_hidden = [x0 <= b[0] and b[0] + side <= x1 and y0 <= b[1] and b[1] + side <= y1 for b in boxes]
+    return images, boxes, fully_hidden
+
+
+def test_a_hidden_subject_is_not_reported_on_a_lookalike(shared_data):
+    """NanoTrack's foreground score stays near 1 on background; the deep-feature likeness makes the
+    subject tracker say ``searching`` and then ``lost`` instead of ``tracking`` on a look-alike."""
+    images, boxes, hidden = _lookalike_occlusion(shared_data)
+    subject = SubjectTracker("nanotrack", NanoTrackBackend(shared_data / "models"))
+    subject.init(images[0], boxes[0], 0.0)
+    estimates = [subject.update(image, i / 30.0) for i, image in enumerate(images[1:], 1)]
+    hidden_estimates = [e for e, h in zip(estimates, hidden[1:]) if h]
+    assert len(hidden_estimates) >= 25
+    assert not any(e.state is TrackState.TRACKING for e in hidden_estimates)
+    assert hidden_estimates[-1].state is TrackState.LOST
+    assert all(e.state is not TrackState.TRACKING or iou(e.box, box) > 0.3 for e, box in zip(estimates, boxes[1:]))
+
+
+def test_the_score_falls_where_the_subject_is_gone_though_the_foreground_score_stays_high(tmp_path):
+    """With a head sure of the foreground everywhere, only the likeness of the backbone's features
+    (here: mean colours of 16 px blocks) under the chosen box to the subject's tells them apart. Its
+    flat scores tie, and the cosine window's first maximum moves the box 16 px up and left a frame
+    (without velocity), so the frames are one colour each."""
+    models = fake_onnx.write_nanotrack_files(tmp_path, fake_onnx.backbone_bytes(), fake_onnx.head_bytes(sure=True))
+    subject = np.full((480, 640, 3), (20, 40, 220), np.uint8)
+    ground = np.full((480, 640, 3), (200, 60, 20), np.uint8)
+    backend = NanoTrackBackend(models, NanoTrackParams(velocity_gain=0.0))
+    backend.init(subject, (288.0, 208.0, 64.0, 64.0))
+    assert min(backend.update(subject)[1] for _ in range(3)) > 0.9
+    assert max(backend.update(ground)[1] for _ in range(3)) < 0.5
+    assert min(backend.update(subject)[1] for _ in range(3)) > 0.9  # the typical likeness did not sink
