@@ -68,15 +68,20 @@ def test_filters_refuse_to_respond_before_learning():
         ScaleFilter(5, 1.0).respond(np.zeros((5, 3), np.float32))
 
 
+def _learnt_likelihood(patch: np.ndarray, foreground: np.ndarray) -> np.ndarray:
+    """A colour model that learnt ``patch``'s ``foreground`` against the rest, applied to ``patch``."""
+    model = ColourModel()
+    model.learn(colour_index(patch), foreground, ~foreground, rate=1.0)
+    return model.likelihood(colour_index(patch))
+
+
 def test_colour_model_tells_the_subject_from_the_background():
     patch = np.zeros((40, 40, 3), np.uint8)
     patch[..., 0] = 200  # blue background
     patch[12:24, 12:24] = (0, 0, 220)  # a red subject on cells 3..5
     foreground = np.zeros((40, 40), bool)
     foreground[13:23, 13:23] = True
-    model = ColourModel()
-    model.learn(colour_index(patch), foreground, ~foreground, rate=1.0)
-    likelihood = model.likelihood(colour_index(patch))
+    likelihood = _learnt_likelihood(patch, foreground)
     assert likelihood[18, 18] > 0.9 and likelihood[2, 2] < 0.1
     response = box_response(likelihood, 4, (3, 3))
     assert np.unravel_index(np.argmax(response), response.shape) == (4, 4)
@@ -171,3 +176,14 @@ def test_backend_rescales_and_learns_only_every_update_every_frames(every):
 def test_update_every_must_be_positive():
     with pytest.raises(ValueError, match="update_every"):
         DcfSettings(update_every=0)
+
+
+@pytest.mark.parametrize("channel", [0, 1, 2], ids=["blue", "green", "red"])
+def test_a_subject_differing_in_one_colour_channel_is_told_apart(channel: int) -> None:
+    """The colour histogram is joint over blue, green and red: one channel's difference suffices."""
+    patch = np.full((20, 20, 3), 60, np.uint8)
+    patch[5:15, 5:15, channel] = 220
+    foreground = np.zeros((20, 20), bool)
+    foreground[5:15, 5:15] = True
+    likelihood = _learnt_likelihood(patch, foreground)
+    assert likelihood[10, 10] > 0.9 and likelihood[1, 1] < 0.1
