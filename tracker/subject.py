@@ -54,7 +54,7 @@ class SubjectTracker:
         self.settings = settings or TrackerSettings()
         self._kalman = BoxKalman()
         self._appearance: AppearanceModel | None = None
-        self._size: tuple[float, float] = (0.0, 0.0)
+        self._size: tuple[float, float] = (0.0, 0.0)  # the subject's size when last seen confidently
         self._misses = 0
         self._frame_index = -1
 
@@ -99,8 +99,8 @@ class SubjectTracker:
                 timestamp: float) -> TargetEstimate:
         s = self.settings
         self._misses = 0
-        self._size = (box[2], box[3])
         if confidence >= s.adapt_confidence:
+            self._size = (box[2], box[3])  # not a box shrinking as the subject slides out of sight
             self._appearance.adapt(patch, s.adapt_rate)  # the patch the similarity was measured on
         if s.refine_blend > 0:
             box = self._refine(frame, box)
@@ -122,7 +122,8 @@ class SubjectTracker:
         self._misses = 0
 
     def _search(self, frame: np.ndarray, predicted: Box) -> Match:
-        """Template search around the prediction, widening while the subject stays unseen."""
+        """Template search around the prediction, widening while the subject stays unseen, for a
+        box of the subject's size on its last confident frame."""
         s = self.settings
         reach = min(s.max_reach, s.search_reach * (1.0 + 0.25 * self._misses))
         best = self._appearance.search(frame, predicted, self._size, reach)
