@@ -14,15 +14,6 @@ import numpy as np
 
 def to_plain(value: Any) -> Any:
     """A JSON-ready copy: numpy values, enums, tuples and dataclasses converted; NaN/inf become None."""
-    kind = type(value)  # the plain types first, by exact type: a telemetry record is mostly floats
-    if kind is float:
-        return value if math.isfinite(value) else None
-    if kind is str or kind is int or value is None:
-        return value
-    if kind is list or kind is tuple:
-        return [to_plain(item) for item in value]
-    if kind is dict:
-        return {str(key): to_plain(item) for key, item in value.items()}
     if isinstance(value, Enum):
         return to_plain(value.value)
     if isinstance(value, np.generic):
