@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from tracker.backends import BACKEND_NAMES, make_backend
+from tracker.detectors import Detector
 from tracker.nanotrack import nanotrack_model_files
 from tracker.subject import SubjectTracker, TrackerSettings
 
@@ -18,8 +19,9 @@ def available_trackers() -> list[str]:
     return ["default", *BACKEND_NAMES]
 
 
-def make_tracker(name: str = "default", model_dir: str | Path | None = None) -> SubjectTracker:
-    """A subject tracker by name.
+def make_tracker(name: str = "default", model_dir: str | Path | None = None,
+                 detector: Detector | None = None) -> SubjectTracker:
+    """A subject tracker by name; ``detector``, if given, helps it find a lost subject again.
 
     ``default`` picks NanoTrack when ``model_dir`` holds its files, else the correlation filter.
     Unknown names raise ``ValueError``; missing model files raise ``FileNotFoundError``.
@@ -29,7 +31,7 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None) -> 
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
     backend = make_backend(name, model_dir)  # missing model files fail here, not on init()
-    return SubjectTracker(name, backend, settings=_SETTINGS.get(name))
+    return SubjectTracker(name, backend, detector, _SETTINGS.get(name))
 
 
 def _has_nanotrack(model_dir: str | Path) -> bool:
