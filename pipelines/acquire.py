@@ -43,21 +43,19 @@ class StartConfirmer:
 
 
 def pick_candidate(detections: Sequence[Detection], frame_size: tuple[int, int],
-                   pick: str = "central", near: tuple[float, float] | None = None) -> Detection | None:
-    """The detection to follow: nearest ``near`` when given (re-acquisition), else the most
-    central or the largest one; None when there is none."""
+                   pick: str = "central") -> Detection | None:
+    """The detection to start on: the most central or the largest one; None when there is none."""
     if not detections:
         return None
     if pick not in PICKS:
         raise ValueError(f"unknown pick {pick!r} (choose from {', '.join(PICKS)})")
     width, height = frame_size
-    target = near if near is not None else (width / 2.0, height / 2.0)
 
     def distance(d: Detection) -> float:
         x, y, w, h = d.box
-        return math.hypot(x + w / 2.0 - target[0], y + h / 2.0 - target[1])
+        return math.hypot(x + w / 2.0 - width / 2.0, y + h / 2.0 - height / 2.0)
 
-    if near is None and pick == "largest":
+    if pick == "largest":
         return max(detections, key=lambda d: d.box[2] * d.box[3])
     return min(detections, key=distance)
 

@@ -32,7 +32,7 @@ from pipelines.sources import Frame, FrameSource
 from tracker import make_tracker
 from tracker.detectors import Detector, make_detector
 from tracker.datasets import ASSUMED_FPS
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.estimate import TargetEstimate
 
 log = logging.getLogger(__name__)
 
@@ -116,9 +116,10 @@ class TrackSession:
         self.camera = CameraModel(width, height, hfov_deg=options.hfov_deg)
         self.controller = make_controller(options.controller, camera=self.camera,
                                           config=control_config(options.max_speed_dps))
-        self.tracker = make_tracker(options.tracker, options.model_dir)
         self.detector: Detector | None = (make_detector(options.detect, options.model_dir)
                                           if options.detect else None)
+        # the tracker runs the detector itself, on every frame while the subject is lost
+        self.tracker = make_tracker(options.tracker, options.model_dir, self.detector)
         self._confirmer = StartConfirmer(
             max_moving_fraction=CAMERA_MOTION_FRACTION if options.detect == "motion" else None)
         self.feedback = (source.is_live if options.attitude_feedback == "auto"
@@ -191,30 +192,25 @@ class TrackSession:
             self.write_summary(sync=False)
 
     def _track(self, frame: Frame, stamp: float) -> TargetEstimate | None:
+        """None until the subject is chosen; then the tracker's estimate. A lost subject is found
+        again by the tracker: a detection that looks like it (``SubjectTracker``), never merely the
+        nearest one, so the subject's look is kept and another person's is not taken for it."""
         if self._estimate is None:
-            box = self.options.roi if self.options.roi is not None else self._detect(frame, None)
+            box = self.options.roi if self.options.roi is not None else self._detect(frame)
             if box is None:
                 return None
             self._estimate = self.tracker.init(frame.image, box, stamp)
             return self._estimate
-        estimate = self.tracker.update(frame.image, stamp)
-        if estimate.state is not TrackState.LOST:
-            self._confirmer.reset()  # a re-acquisition must persist from the loss on
-        elif self.detector is not None:
-            box = self._detect(frame, estimate.center)
-            if box is not None:
-                estimate = self.tracker.init(frame.image, box, stamp)
-        self._estimate = estimate
-        return estimate
+        self._estimate = self.tracker.update(frame.image, stamp)
+        return self._estimate
 
-    def _detect(self, frame: Frame, near: tuple[float, float] | None) -> tuple[float, ...] | None:
-        """A confirmed detection to (re)start on: the pick rule for a start, nearest ``near`` for
-        a re-acquisition. Runs on every frame while acquiring or lost (the motion detector needs
-        consecutive frames)."""
+    def _detect(self, frame: Frame) -> tuple[float, ...] | None:
+        """A confirmed detection to start on, by the pick rule. Runs on every frame while acquiring
+        (the motion detector needs consecutive frames)."""
         if self.detector is None:
             return None
         confirmed = self._confirmer.offer(self.detector.detect(frame.image), self.source.size)
-        found = pick_candidate(confirmed, self.source.size, self.options.pick, near)
+        found = pick_candidate(confirmed, self.source.size, self.options.pick)
         return None if found is None else tuple(found.box)
 
     def _attitude_at(self, stamp: float) -> tuple[float, float] | None:

@@ -38,14 +38,12 @@ def test_frames_where_the_camera_moved_are_skipped():
     assert started[:2] == [[], []] and started[2] == [SUBJECT]
 
 
-def test_pick_central_largest_and_near():
+def test_pick_central_and_largest():
     small_central = Detection((300.0, 160.0, 20.0, 20.0), 1.0)
     large_corner = Detection((0.0, 0.0, 200.0, 200.0), 1.0)
     both = [large_corner, small_central]
     assert pick_candidate(both, SIZE, "central") == small_central
     assert pick_candidate(both, SIZE, "largest") == large_corner
-    assert pick_candidate(both, SIZE, "largest", near=(10.0, 10.0)) == large_corner
-    assert pick_candidate(both, SIZE, "central", near=(90.0, 90.0)) == large_corner
     assert pick_candidate([], SIZE) is None
 
 

@@ -1,11 +1,10 @@
-"""Where subject choice draws its lines: a persistence window of exactly ``window`` frames, a
-re-acquisition that follows the nearest detection whatever the pick, and a --roi kept from half
-inside the frame on."""
+"""Where subject choice draws its lines: a persistence window of exactly ``window`` frames and a
+--roi kept from half inside the frame on."""
 from __future__ import annotations
 
 import pytest
 
-from pipelines.acquire import StartConfirmer, check_roi_in_frame, pick_candidate
+from pipelines.acquire import StartConfirmer, check_roi_in_frame
 from tracker.detectors import Detection
 
 SIZE = (640, 360)
@@ -19,12 +18,6 @@ def test_only_sightings_within_the_window_count(gap: int, started: bool) -> None
     for frame in [[SUBJECT], [SUBJECT], *[[]] * gap]:
         assert confirmer.offer(frame, SIZE) == []
     assert confirmer.offer([SUBJECT], SIZE) == ([SUBJECT] if started else [])
-
-
-def test_a_reacquisition_takes_the_nearest_even_when_picking_the_largest() -> None:
-    near_small = Detection((300.0, 160.0, 20.0, 20.0), 1.0)
-    far_large = Detection((0.0, 0.0, 200.0, 200.0), 1.0)
-    assert pick_candidate([far_large, near_small], SIZE, "largest", near=(310.0, 170.0)) == near_small
 
 
 @pytest.mark.parametrize("roi, kept", [((590, 300, 100, 60), True),    # half inside

@@ -27,21 +27,28 @@ BOX = 40  # the synthetic subject's side in pixels
 Position = Callable[[int], tuple[int, int] | None]  # frame index -> subject top-left, None: gone
 
 
-def make_clip(path: Path, frames: int, position: Position, fps: float = 30.0) -> Path:
-    """A Motion JPEG clip: a fixed textured background and a checkered square at ``position(i)``."""
+def make_clip(path: Path, frames: int, position: Position, fps: float = 30.0,
+              other: Position | None = None) -> Path:
+    """A Motion JPEG clip: a fixed textured background and a checkered square at ``position(i)``;
+    with ``other``, a striped square of the same size (another thing, which does not look like it)
+    at ``other(i)``, behind the subject."""
     rng = np.random.default_rng(7)
     width, height = SIZE
     background = cv2.GaussianBlur(rng.integers(60, 200, (height, width, 3), dtype=np.uint8), (5, 5), 0)
     tile = np.indices((BOX, BOX)).sum(axis=0) // 8 % 2
     subject = np.where(tile[..., None] == 1, (20, 40, 230), (240, 240, 30)).astype(np.uint8)
+    stripes = np.where(np.indices((BOX, BOX))[1][..., None] // 5 % 2 == 1, (235, 235, 235), (20, 20, 20))
+    looks = [(stripes.astype(np.uint8), other or (lambda i: None)), (subject, position)]
 
     def image(i: int) -> np.ndarray:
         image = background.copy()
-        where = position(i)
-        if where is not None:
-            x, y = where  # the square may stand partly outside the frame
-            visible = subject[:max(0, min(BOX, height - y)), :max(0, min(BOX, width - x))]
-            image[y:y + visible.shape[0], x:x + visible.shape[1]] = visible
+        for look, place in looks:
+            where = place(i)
+            if where is not None:  # the square may stand partly outside the frame
+                x, y = where
+                x0, y0 = max(x, 0), max(y, 0)
+                visible = look[y0 - y:max(0, min(BOX, height - y)), x0 - x:max(0, min(BOX, width - x))]
+                image[y0:y0 + visible.shape[0], x0:x0 + visible.shape[1]] = visible
         return image
 
     return write_clip(path, (image(i) for i in range(frames)), fps, "MJPG")
