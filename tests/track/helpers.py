@@ -28,12 +28,12 @@ Position = Callable[[int], tuple[int, int] | None]  # frame index -> subject top
 
 
 def make_clip(path: Path, frames: int, position: Position, fps: float = 30.0,
-              other: Position | None = None) -> Path:
-    """A Motion JPEG clip: a fixed textured background and a checkered square at ``position(i)``;
-    with ``other``, a striped square of the same size (another thing, which does not look like it)
-    at ``other(i)``, behind the subject."""
+              other: Position | None = None, size: tuple[int, int] = SIZE) -> Path:
+    """A Motion JPEG clip of ``size`` (w, h): a fixed textured background and a checkered square at
+    ``position(i)``; with ``other``, a striped square of the same size (another thing, which does
+    not look like it) at ``other(i)``, behind the subject."""
     rng = np.random.default_rng(7)
-    width, height = SIZE
+    width, height = size
     background = cv2.GaussianBlur(rng.integers(60, 200, (height, width, 3), dtype=np.uint8), (5, 5), 0)
     tile = np.indices((BOX, BOX)).sum(axis=0) // 8 % 2
     subject = np.where(tile[..., None] == 1, (20, 40, 230), (240, 240, 30)).astype(np.uint8)
