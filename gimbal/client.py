@@ -31,7 +31,7 @@ import can
 from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError, ReturnCodeError, SendError
 from gimbal.framer import Dropped
 from gimbal.messages import (Message, PayloadError, Reply, decode_message, is_device_push,
-                             message_packet, reply_key)
+                             message_packet, reply_fits, reply_key)
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, FocusPositionReply,
@@ -349,16 +349,22 @@ class GimbalClient:
 
         By SEQ first. Unless the gimbal is known to echo SEQs, a reply whose SEQ matches
         nothing goes to the oldest request with its CmdSet/CmdID (latest layout) or to the oldest
-        request (legacy layout); for a gimbal that echoes, such a reply is stale. Raises
+        request (legacy layout); for a gimbal that echoes, such a reply is stale. A focus motor
+        reply (0x12) only answers a request of the sub-command it echoes. Raises
         ``PayloadError`` for a reply too short to say which command it answers.
         """
         key = reply_key(packet)
         legacy = key is None
+        payload = packet.data if legacy else packet.data[2:]
+
+        def answers(w: PendingReply) -> bool:
+            return (legacy or w.key == key) and reply_fits(w.request.REPLY, payload)
+
         with self._lock:
             waiter = self._pending.get(packet.seq)
-            echoed = waiter is not None and (legacy or waiter.key == key)
+            echoed = waiter is not None and answers(waiter)
             if not echoed:
-                waiter = next((w for w in self._pending.values() if legacy or w.key == key), None)
+                waiter = next((w for w in self._pending.values() if answers(w)), None)
             self._note_echo(echoed, waiter is not None)
             if waiter is not None and not echoed and self._seq_echoed:
                 waiter = None

@@ -48,6 +48,13 @@ def is_device_push(packet: Packet) -> bool:
     return len(data) >= 2 and (data[0], data[1]) in DEVICE_PUSHES
 
 
+def reply_fits(reply_cls: type[Message], payload: bytes) -> bool:
+    """Whether ``payload`` can be a ``reply_cls`` reply: the focus motor replies (0x0E/0x12) echo
+    the command's sub-ID (section 2.3.4.19: 与命令帧数据一致, "the same as in the command"); a
+    reply carrying its return code alone fits any."""
+    return len(payload) < 2 or reply_cls.matches(payload)
+
+
 def decode_message(packet: Packet, request: type[Message] | Message | None = None) -> Message:
     """The typed message a packet carries.
 
@@ -78,6 +85,9 @@ def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Me
         key, payload = (request.CMD_SET, request.CMD_ID), packet.data
     expected = getattr(request, "REPLY", None)
     if expected is not None and (expected.CMD_SET, expected.CMD_ID) == key:
+        if not reply_fits(expected, payload):
+            raise PayloadError(f"{expected.NAME}: payload {payload.hex(' ')} is another sub-command's "
+                               "reply (its sub-ID does not echo the command's)")
         return expected.decode_payload(payload)
     if key not in REPLIES:
         raise UnknownMessageError(f"reply to 0x{key[0]:02X}/0x{key[1]:02X}: the document defines none")
@@ -99,4 +109,4 @@ def message_packet(message: Message, seq: int, cmd_type: int | None = None,
 __all__ = ["CAMERA_CMD_SET", "GIMBAL_CMD_SET", "Command", "DevicePush", "HostPush", "Kind", "Message",
            "PayloadError", "Reply", "ReturnCodeReply", "Sender", "Tlv", "UnknownMessageError",
            "all_message_classes", "decode_message", "is_device_push", "is_legacy_reply", "message_packet",
-           "reply_key"]
+           "reply_fits", "reply_key"]
