@@ -8,7 +8,10 @@ Replies are matched to requests by SEQ when the gimbal echoes it, otherwise by C
 (latest layout) or to the oldest outstanding request (legacy layout, which has no CmdSet/CmdID).
 Once the gimbal has echoed a SEQ, a reply with an unknown SEQ is stale; ``ECHO_EVIDENCE`` replies
 in a row that could only be paired by command (a gimbal with a fixed SEQ or its own counter, one
-of which matched by chance) switch that back.
+of which matched by chance) switch that back. Before the first echo, a reply to another host on
+a shared bus cannot be told from a non-echoing gimbal's and is paired by command; when our own
+reply then arrives echoing our SEQ, echoing is learnt (``misattributed_replies``), so that costs
+one request, not every one.
 A retry resends the *same* packet with the same SEQ, so a late reply to any attempt completes the
 call. Commands whose repetition changes the outcome (relative moves, toggles, camera actions)
 are never retried. Replies that match no outstanding request (``stale_replies``), or are too short
@@ -20,7 +23,7 @@ import atexit
 import logging
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from types import TracebackType
@@ -60,6 +63,7 @@ FIRST_SEQ = 0x1122  # DJI's demo starts here
 RX_POLL_S = 0.05  # how often the receive thread looks at the closing flag
 RX_GIVE_UP_S = 0.25  # receive errors for this long, without a frame between, mean the bus is lost
 ECHO_EVIDENCE = 3  # replies in a row paired only by command that show the gimbal does not echo SEQs
+PAIRED_BY_COMMAND_KEPT = 16  # SEQs of the latest requests paired by command, for a late echo
 MAX_TIMEOUT = threading.TIMEOUT_MAX  # longer waits overflow the platform's time_t
 ANGLE_KINDS = {"attitude": ANGLES_ATTITUDE, "joint": ANGLES_JOINT}
 FOLLOW_MODES = {"lock": FOLLOW_LOCK, "yaw": FOLLOW_YAW, "fpv": FOLLOW_FPV}
@@ -190,6 +194,8 @@ class GimbalClient:
         self._seq = FIRST_SEQ
         self._seq_echoed = False  # learnt from a reply that echoes its request's SEQ (see _note_echo)
         self._unechoed_run = 0  # replies in a row since then that could only be paired by command
+        self._paired_by_command: deque[tuple[int, tuple[int, int] | None]] = \
+            deque(maxlen=PAIRED_BY_COMMAND_KEPT)  # (SEQ, reply key) of requests paired by command
         self._closing = threading.Event()
         self._closed = False
         self._rx_error: BaseException | None = None
@@ -365,12 +371,26 @@ class GimbalClient:
             echoed = waiter is not None and answers(waiter)
             if not echoed:
                 waiter = next((w for w in self._pending.values() if answers(w)), None)
+                if waiter is None and (packet.seq, key) in self._paired_by_command:
+                    self._late_echo(packet.seq)
             self._note_echo(echoed, waiter is not None)
             if waiter is not None and not echoed and self._seq_echoed:
                 waiter = None
             if waiter is not None:
                 del self._pending[waiter.seq]
+                if not echoed:
+                    self._paired_by_command.append((waiter.seq, key))
             return waiter
+
+    def _late_echo(self, seq: int) -> None:
+        """A reply echoing the SEQ of a request that an earlier reply, paired by command, already
+        completed: the gimbal echoes after all, and that earlier reply was someone else's (another
+        host's on a shared bus). Replies with unknown SEQs are stale from now on (lock held)."""
+        self.stats["misattributed_replies"] += 1
+        log.warning("reply SEQ 0x%04X echoes a request already answered by a reply paired by "
+                    "command (another host's?): pairing by SEQ only from now on", seq)
+        self._seq_echoed, self._unechoed_run = True, 0
+        self._paired_by_command.clear()
 
     def _note_echo(self, echoed: bool, by_command: bool) -> None:
         """A reply that echoed its request's SEQ shows the gimbal echoes; ``ECHO_EVIDENCE`` in a

@@ -554,3 +554,23 @@ def test_a_plain_oserror_from_a_third_party_bus_is_a_bus_error(channel: str) -> 
     with GimbalClient(bus) as gimbal, pytest.raises(BusError, match="No buffer space"):
         gimbal.version()
     bus.shutdown()
+
+
+def test_another_hosts_reply_before_the_first_echo_costs_one_request_only(
+        client: GimbalClient, peer: ScriptedPeer) -> None:
+    """On a bus shared with another host, a reply to its GetAngles (its own SEQ) can arrive
+    before ours while the client has not yet seen the gimbal echo a SEQ: it is paired by command
+    (a gimbal that does not echo looks the same). Our own reply, echoing our SEQ, arrives just
+    after: that shows the gimbal echoes, so the next foreign reply is stale instead of taken
+    again for every later request."""
+    foreign = encode_packet(Packet.reply(0x0E, 0x02, bytes((0, 1)) + (111).to_bytes(2, "little", signed=True)
+                                         + bytes(4), seq=0x0005))
+    peer.answer(GetAngles, AnglesReply(0, 1, 222, 0, 0), delay=0.1)
+    first = client.submit(GetAngles())
+    peer.transport.send(foreign)
+    assert first.wait(2.0) and client.result(first).yaw == 111  # indistinguishable, the first time
+    poll(lambda: client.stats["stale_replies"] == 1)  # our own reply, too late
+    second = client.submit(GetAngles())
+    peer.transport.send(foreign)
+    assert second.wait(2.0) and client.result(second).yaw == 222
+    assert client.stats["stale_replies"] == 2 and client.stats["misattributed_replies"] == 1
