@@ -321,7 +321,7 @@ class GimbalClient:
     def _on_bus_lost(self) -> None:
         streamer = self._streamer
         if streamer is not None:
-            streamer.halt(BusError(f"bus lost: {self._rx_error}"))
+            streamer.halt(BusError(f"the receive thread stopped: {self._rx_error}"))
         if self._speed_engaged:
             self.stop_and_release()
 
@@ -537,7 +537,9 @@ class GimbalClient:
     def on_push(self, cls: type[Message], callback: PushCallback) -> Callable[[], None]:
         """Call ``callback(msg, t)`` (t = ``time.monotonic()`` at arrival) for every ``cls`` push,
         on the receive thread; exceptions are logged. Keep it quick: replies wait while it runs,
-        and it cannot make requests (``GimbalError``). Returns an unsubscribe function."""
+        and it cannot make requests (``GimbalError``). ``sys.exit()`` in it cannot end the program
+        from that thread: it ends the receive thread, which stops the gimbal as a lost bus does,
+        and later calls raise ``BusError`` naming the callback. Returns an unsubscribe function."""
         return self.pushes.subscribe(cls, callback)
 
     def latest(self, cls: type[Message]) -> tuple[Message, float] | None:

@@ -8,13 +8,18 @@ from collections import Counter
 from collections.abc import Callable
 from typing import TypeVar
 
-from gimbal.errors import GimbalTimeoutError
+from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.messages import Kind, Message, Sender
 
 log = logging.getLogger(__name__)
 
 M = TypeVar("M", bound=Message)
 PushCallback = Callable[[M, float], None]
+
+
+class CallbackExit(GimbalError):
+    """A subscriber raised SystemExit (or another exception that is not an ``Exception``): the
+    thread delivering pushes ends with this."""
 
 
 def _check_push_class(cls: type[Message]) -> None:
@@ -25,7 +30,8 @@ def _check_push_class(cls: type[Message]) -> None:
 
 class PushHub:
     """Keeps the latest push of each class with its arrival time (``time.monotonic()``) and calls
-    subscribers. A subscriber that raises is logged and stays subscribed."""
+    subscribers. A subscriber that raises an ``Exception`` is logged and stays subscribed; one that
+    raises SystemExit ends the delivering thread (``CallbackExit``)."""
 
     def __init__(self) -> None:
         self._cond = threading.Condition()
@@ -60,6 +66,8 @@ class PushHub:
                 callback(message, t)
             except Exception:  # a user's bug must not stop the receive thread
                 log.exception("push callback %r failed on %s", callback, message.NAME)
+            except BaseException as exc:  # sys.exit(): it ends this thread, as in any thread
+                raise CallbackExit(f"push callback {callback!r} raised {exc!r} on {message.NAME}") from exc
 
     def latest(self, cls: type[M]) -> tuple[M, float] | None:
         """The newest ``cls`` push and its arrival time, or None if none arrived yet."""

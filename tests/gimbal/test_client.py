@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import logging
 import signal
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -574,3 +575,18 @@ def test_another_hosts_reply_before_the_first_echo_costs_one_request_only(
     peer.transport.send(foreign)
     assert second.wait(2.0) and client.result(second).yaw == 222
     assert client.stats["stale_replies"] == 2 and client.stats["misattributed_replies"] == 1
+
+
+def test_sys_exit_in_a_push_callback_stops_the_gimbal_and_says_so(client: GimbalClient,
+                                                                   peer: ScriptedPeer) -> None:
+    """``sys.exit()`` in a callback ends the receive thread (it cannot end the program from
+    there): the gimbal gets its stop, and later calls name the callback's SystemExit instead of
+    an empty "the receive thread stopped: " that reads like a lost bus."""
+    peer.answer(SpeedControl)
+    client.speed(0, 15)
+    client.on_push(ParameterPush, lambda message, t: sys.exit())
+    peer.push(ParameterPush(0x01, 10, 20, 30))
+    poll(lambda: not client.alive)
+    poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])
+    with pytest.raises(BusError, match=r"push callback .* raised SystemExit\(\)"):
+        client.get_angles()
