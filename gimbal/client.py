@@ -254,8 +254,11 @@ class GimbalClient:
         """Zero speed (still in control), then zero with control released (bit 7 clear).
 
         With a live receive thread each waits for its reply (no retries: a failure is logged);
-        once the bus is known lost they are only sent, best effort. ``stats`` counts those that
-        went out (``stop_zero_sent``, ``stop_release_sent``).
+        once the bus is known lost, or the client closed, they are only sent, best effort: a
+        stop asked for explicitly always goes out while the bus can carry it (on a bus this
+        client does not own, one still open), since an extra stop costs a controller one tick and
+        a missing one can leave the gimbal in SDK speed control. ``stats`` counts those that went
+        out (``stop_zero_sent``, ``stop_release_sent``).
         """
         for message in stop_messages():
             name = "stop_zero_sent" if message.ctrl_byte & SPEED_TAKE_CONTROL else "stop_release_sent"
