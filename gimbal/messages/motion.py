@@ -15,6 +15,7 @@ PITCH_ANGLE_RANGE = (-560, 1460)
 SPEED_RANGE = (-3600, 3600)  # the document gives 0..360 °/s as a magnitude; the sign is direction
 DECI_DEGREE = (0.1, "°")
 DECI_DEGREE_PER_S = (0.1, "°/s")
+DECI_SECOND = (0.1, " s")
 
 POSITION_ABSOLUTE = 0x01
 POSITION_YAW_INVALID = 0x02
@@ -64,7 +65,8 @@ class PositionControl(Command):
     FORMAT: ClassVar[str] = "hhhBB"
     RANGES: ClassVar = {"yaw_angle": YAW_ANGLE_RANGE, "roll_angle": ROLL_ANGLE_RANGE,
                         "pitch_angle": PITCH_ANGLE_RANGE, "ctrl_byte": (0, 0x0F)}
-    UNITS: ClassVar = {"yaw_angle": DECI_DEGREE, "roll_angle": DECI_DEGREE, "pitch_angle": DECI_DEGREE}
+    UNITS: ClassVar = {"yaw_angle": DECI_DEGREE, "roll_angle": DECI_DEGREE, "pitch_angle": DECI_DEGREE,
+                       "time_for_action": DECI_SECOND}
     REPLY: ClassVar = PositionControlReply
     yaw_angle: int = 0
     roll_angle: int = 0

@@ -19,6 +19,7 @@ FLAG_STIFFNESS_VALID = 0x04
 DEVICE_ID_RESERVED = 0x00000000
 DEVICE_ID_R_SDK = 0x00000001
 DEVICE_ID_REMOTE_CONTROLLER = 0x00000002
+DEVICE_ID_RANGE = (DEVICE_ID_RESERVED + 1, 0xFFFFFFFF)  # 2.3.3 Figure 6: 0x00000000 is reserved (保留)
 
 
 @register
@@ -123,6 +124,7 @@ class VersionQuery(Command):
     CMD_ID: ClassVar[int] = 0x09
     NAME: ClassVar[str] = "version_query"
     FORMAT: ClassVar[str] = "I"
+    RANGES: ClassVar = {"device_id": DEVICE_ID_RANGE}
     REPLY: ClassVar = VersionReply
     device_id: int = DEVICE_ID_R_SDK
 
@@ -140,6 +142,7 @@ class VersionPush(HostPush):
     CMD_ID: ClassVar[int] = 0x09
     NAME: ClassVar[str] = "version_push"
     FORMAT: ClassVar[str] = "II"
+    RANGES: ClassVar = {"device_id": DEVICE_ID_RANGE}
     device_id: int = DEVICE_ID_R_SDK
     version: int = 0
 

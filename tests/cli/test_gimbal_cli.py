@@ -47,6 +47,12 @@ def test_print_packet_for_a_query_uses_the_given_seq(capsys: pytest.CaptureFixtu
     (["speed", "--pitch", "-400"], "pitch_speed=-4000 is outside"),
     (["stiffness", "--pitch", "101", "--roll", "1", "--yaw", "1"], "pitch_stiffness=101"),
     (["focus", "position", "5000"], "position=5000 is outside 0..4095"),
+    # 2.3.4.1: time_for_action "uint8_t 命令执行速度，单位 0.1s" (execution speed, unit 0.1 s):
+    # 25.5 s at most, and the error says so in seconds as --time is given
+    (["move", "--pitch", "10", "--time", "30"], "(30 s: allowed 0..25.5 s)"),
+    # 2.3.3 Figure 6: "0x00000000 保留" (device ID 0 is reserved)
+    (["version", "--device-id", "0"], "device_id=0 is outside 1..4294967295"),
+    (["version", "--device-id", "0", "--announce", "0x01000000"], "device_id=0 is outside 1.."),
     (["user-params", "--param-table", "3"], "param_table=3 is outside 0..2"),
     (["move"], "give at least one of --yaw, --roll, --pitch"),
     (["angles", "--timeout", "inf"], "--timeout must be a number of seconds above 0"),
