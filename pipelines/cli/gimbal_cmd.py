@@ -284,7 +284,8 @@ def _watch(client: GimbalClient, args: argparse.Namespace) -> None:
 
 
 def _version_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--device-id", type=parse_int, default=1, help="1: DJI R SDK (default), 2: remote")
+    p.add_argument("--device-id", type=parse_int, default=1,
+                   help="device ID (section 2.3.3): 1 DJI R SDK (default), 2 remote controller; 0 is reserved")
     p.add_argument("--announce", type=parse_int, metavar="VERSION",
                    help="instead of asking, announce this device's version (0xAABBCCDD) to the gimbal")
 
@@ -305,9 +306,13 @@ def _version(client: GimbalClient, args: argparse.Namespace) -> Result:
 
 def _user_params_args(p: argparse.ArgumentParser) -> None:
     motors = p.add_mutually_exclusive_group()
-    motors.add_argument("--motors-off", dest="motors_off", action="store_const", const=True)
-    motors.add_argument("--motors-on", dest="motors_off", action="store_const", const=False)
-    p.add_argument("--roll360-mode", choices=list(ROLL360_MODES.values()))
+    motors.add_argument("--motors-off", dest="motors_off", action="store_const", const=True,
+                        help="turn the motors off (parameter 0x23, bit 0 set)")
+    motors.add_argument("--motors-on", dest="motors_off", action="store_const", const=False,
+                        help="turn the motors back on (parameter 0x23, bit 0 clear)")
+    p.add_argument("--roll360-mode", choices=list(ROLL360_MODES.values()),
+                   help="parameter 0x22, bits 3..5: normal three-axis (0), two-axis (1), roll 360 (2), "
+                   "3D roll 360 (3)")
     p.add_argument("--param-table", type=int, help="parameter table 0..2")
 
 
@@ -347,8 +352,12 @@ def _camera_action(name: str | None) -> Callable[[argparse.Namespace], list[Mess
 
 
 def _focus_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("action", choices=("position", "calibrate", "read"))
-    p.add_argument("value", nargs="?", help="position 0..4095, or auto|manual|set-min|set-max|stop")
+    p.add_argument("action", choices=("position", "calibrate", "read"),
+                   help="position: absolute position push, unanswered (sub-ID 0x01); calibrate: a "
+                   "calibration step (0x02); read: calibration state and position (0x15)")
+    p.add_argument("value", nargs="?",
+                   help="position 0..4095, or auto|manual|set-min|set-max|stop (manual: set-min and "
+                   "set-max at the two ends first, then manual)")
 
 
 def _focus_messages(args: argparse.Namespace) -> list[Message]:
@@ -416,7 +425,9 @@ COMMANDS = [
             _stiffness_messages, _stiffness, _stiffness_args),
     Command("push", "turn the parameter push on or off",
             lambda a: [PushControl(PUSH_ENABLE if a.state == "on" else PUSH_DISABLE)],
-            _ok(lambda c, a: c.set_push(a.state == "on")), _choice_arg("state", ["on", "off"], "")),
+            _ok(lambda c, a: c.set_push(a.state == "on")),
+            _choice_arg("state", ["on", "off"], "on: the gimbal pushes attitude, joint angles, limits and "
+                        "stiffness (0x0E/0x08); off: it stops")),
     Command("watch", "print pushes as they arrive, until Ctrl-C or --duration",
             lambda a: [] if a.no_enable else [PushControl(PUSH_ENABLE)], _watch, _watch_args),
     Command("version", "read a module's version (or --announce one)", _version_messages, _version,
@@ -426,17 +437,23 @@ COMMANDS = [
     Command("mode", "landscape/portrait orientation",
             lambda a: [SetWorkMode(orientation=ORIENTATIONS[a.orientation])],
             _ok(lambda c, a: c.set_work_mode(a.orientation)),
-            _choice_arg("orientation", list(ORIENTATIONS), "orientation to switch to")),
+            _choice_arg("orientation", list(ORIENTATIONS),
+                        "keep: no change; landscape: 0 deg about the X axis; landscape-flipped: 180 deg; "
+                        "portrait: 90 deg; portrait-flipped: -90 deg; toggle: landscape <-> portrait, the "
+                        "gimbal picks the angle; default: back to the default mode")),
     Command("recenter", "recenter once", lambda a: [RecenterSelfie()], _ok(lambda c, a: c.recenter())),
     Command("selfie", "turn around for a selfie", lambda a: [RecenterSelfie(action=SELFIE)],
             _ok(lambda c, a: c.selfie())),
     Command("follow", "follow mode: lock, yaw or fpv",
             lambda a: [SetFollowMode(FOLLOW_MODES[a.mode])],
-            _ok(lambda c, a: c.set_follow_mode(a.mode)), _choice_arg("mode", list(FOLLOW_MODES), "")),
+            _ok(lambda c, a: c.set_follow_mode(a.mode)),
+            _choice_arg("mode", list(FOLLOW_MODES), "lock: gimbal lock (0x00); yaw: yaw follow (0x02); "
+                        "fpv: the document's sport mode, 运动模式 (0x03)")),
     Command("calibrate", "start or stop auto-tuning of the control parameters",
             lambda a: [AutoCalibration((autotune(a.action == "start", 1 if a.single_pose else 0),))],
             _ok(lambda c, a: c.auto_calibration(a.action == "start", 1 if a.single_pose else 0)),
-            lambda p: (p.add_argument("action", choices=["start", "stop"]),
+            lambda p: (p.add_argument("action", choices=["start", "stop"],
+                                      help="start or stop auto-tuning (TLV 0x00, bit 0)"),
                        p.add_argument("--default-mode", dest="single_pose", action="store_false",
                                       help="default tuning instead of the single-pose mode the "
                                       "document recommends")),
@@ -458,10 +475,11 @@ COMMANDS = [
     Command("record", "start or stop recording",
             lambda a: [CameraAction(CAMERA_ACTIONS[f"{a.action}-recording"])],
             _ok(lambda c, a: c.start_recording() if a.action == "start" else c.stop_recording()),
-            _choice_arg("action", ["start", "stop"], "")),
+            _choice_arg("action", ["start", "stop"], "start (0x0003) or stop (0x0004) recording")),
     Command("camera-action", "any camera action of the document", _camera_action(None),
             _ok(lambda c, a: c.camera_action(CAMERA_ACTIONS[a.action])),
-            _choice_arg("action", list(CAMERA_ACTIONS), "")),
+            _choice_arg("action", list(CAMERA_ACTIONS),
+                        ", ".join(f"{name} (0x{code:04X})" for name, code in CAMERA_ACTIONS.items()))),
     Command("camera-status", "is the camera recording?", lambda a: [CameraStatusQuery()],
             lambda c, a: {"recording": c.camera_status()}),
 ]

@@ -2,6 +2,7 @@
 virtual bus (and the built-in simulator when it is present)."""
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import json
 import random
@@ -19,6 +20,7 @@ from gimbal.messages.settings import AngleLimitsReply, GetAngleLimits, SetAngleL
 from gimbal.messages.telemetry import ParameterPush, PushControl, PushControlReply
 from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv
 from pipelines.cli import main
+from pipelines.cli.gimbal_cmd import register
 from tests.gimbal.scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages
 from tests.support import cli_command, free_udp_port, subprocess_env
 
@@ -320,3 +322,15 @@ def test_model_and_output_folders_are_checked(tmp_path: Path) -> None:
 def test_logging_options_also_after_the_command(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["decode", "--hex", "AA", "--verbose"]) == 0
     assert main(["--verbose", "decode", "--hex", "AA"]) == 0
+
+
+def test_every_gimbal_argument_says_what_it_means_in_help() -> None:
+    """Each option and positional of every ``gimbal`` command has help text (choices such as
+    follow's lock/yaw/fpv or mode's orientations were listed without their meaning)."""
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers())
+    gimbal_parser = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices["gimbal"]
+    commands = next(a for a in gimbal_parser._actions if isinstance(a, argparse._SubParsersAction))
+    silent = [f"{name} {action.dest}" for name, sub in commands.choices.items() for action in sub._actions
+              if not isinstance(action, argparse._HelpAction) and not action.help]
+    assert silent == []
