@@ -356,8 +356,8 @@ def _focus_args(p: argparse.ArgumentParser) -> None:
                    help="position: absolute position push, unanswered (sub-ID 0x01); calibrate: a "
                    "calibration step (0x02); read: calibration state and position (0x15)")
     p.add_argument("value", nargs="?",
-                   help="position 0..4095, or auto|manual|set-min|set-max|stop (manual: set-min and "
-                   "set-max at the two ends first, then manual)")
+                   help="position 0..4095, or auto|manual|set-min|set-max|stop|none (manual: set-min "
+                   "and set-max at the two ends first, then manual)")
 
 
 def _focus_messages(args: argparse.Namespace) -> list[Message]:
@@ -382,7 +382,10 @@ def _focus(client: GimbalClient, args: argparse.Namespace) -> Result:
         client.focus_position(message.position)
         return {"position": message.position}
     if isinstance(message, FocusCalibration):
-        return {"calibration": args.value, "succeeded": client.focus_calibration(args.value)}
+        if not client.focus_calibration(args.value):
+            raise CliError(f"focus calibration {args.value}: the focus motor reports it failed "
+                           "(execution result 0x01)", exit_code=1)
+        return {"calibration": args.value, "succeeded": True}
     reply = client.focus_read()
     return {"calibration_state": FOCUS_CALIBRATION_STATES.get(reply.calibration_state, reply.calibration_state),
             "position": reply.position}

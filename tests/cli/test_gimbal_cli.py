@@ -15,6 +15,7 @@ import pytest
 
 from gimbal.messages import Message
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
+from gimbal.messages.external import FocusCalibration, FocusCalibrationReply
 from gimbal.messages.motion import AnglesReply, GetAngles, PositionControl, SpeedControl
 from gimbal.messages.settings import AngleLimitsReply, GetAngleLimits, SetAngleLimits
 from gimbal.messages.telemetry import ParameterPush, PushControl, PushControlReply
@@ -334,3 +335,15 @@ def test_every_gimbal_argument_says_what_it_means_in_help() -> None:
     silent = [f"{name} {action.dest}" for name, sub in commands.choices.items() for action in sub._actions
               if not isinstance(action, argparse._HelpAction) and not action.help]
     assert silent == []
+
+
+def test_a_focus_calibration_step_the_motor_reports_failed_exits_1(
+        channel: str, peer: ScriptedPeer, capsys: pytest.CaptureFixture[str]) -> None:
+    """2.3.4.19 Figure 33: the reply's "执行结果 ... 0x01: 执行失败" (execution result 1: failed)
+    is a failure like a NACK: one line, exit 1 (it printed 'succeeded: False' and exited 0)."""
+    peer.answer(FocusCalibration, FocusCalibrationReply(0, 0x02, 0x00, 0x01))
+    assert gimbal(channel, "focus", "calibrate", "manual") == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "focus calibration manual" in err and "failed" in err
+    peer.answer(FocusCalibration, FocusCalibrationReply(0, 0x02, 0x00, 0x00))
+    assert gimbal(channel, "focus", "calibrate", "manual") == 0
