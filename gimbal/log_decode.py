@@ -20,7 +20,8 @@ import can
 
 from gimbal.errors import PayloadError, RangeError, UnknownMessageError, describe_return_code
 from gimbal.framer import Dropped, PacketFramer
-from gimbal.messages import Kind, Message, decode_message, is_device_push, is_legacy_reply
+from gimbal.messages import (Kind, Message, decode_message, is_device_push, is_legacy_reply,
+                             reply_fits)
 from gimbal.packet import NO_REPLY, Packet, encode_packet
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 
@@ -140,9 +141,12 @@ class LogDecoder:
         """Remove and return the outstanding command a reply answers, if any was seen."""
         self._expire(timestamp)
         key = None if legacy else (_byte(packet.data, 0), _byte(packet.data, 1))
+        payload = packet.data if legacy else packet.data[2:]
 
         def answers(entry: _Outstanding) -> bool:
-            return key is None or (entry.message.CMD_SET, entry.message.CMD_ID) == key
+            request = entry.message
+            return (key is None or (request.CMD_SET, request.CMD_ID) == key) \
+                and reply_fits(request.REPLY, payload)  # a focus reply: its command's sub-ID
 
         candidates = [e for e in self._outstanding if answers(e)]
         match = next((e for e in candidates if e.seq == packet.seq), None) or \

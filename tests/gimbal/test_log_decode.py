@@ -12,6 +12,8 @@ from hypothesis import strategies as st
 from gimbal.log_decode import (GIMBAL_TO_HOST, HOST_TO_GIMBAL, REPLY_WINDOW, LogDecoder,
                                decode_frames, decode_log_file)
 from gimbal.messages import Message, message_packet
+from gimbal.messages.external import (FocusCalibration, FocusCalibrationReply, FocusPositionQuery,
+                                      FocusPositionReply)
 from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl, SpeedControlReply
 from gimbal.messages.telemetry import ParameterPush
 from gimbal.packet import Packet, encode_packet
@@ -97,6 +99,19 @@ def test_unmatched_and_expired_legacy_replies_are_errors() -> None:
     stale = [*frames_of(SpeedControl(), 1, 0x223, 1.0),
              *frames_of(SpeedControlReply(0), 1, 0x222, 1.0 + REPLY_WINDOW + 0.1, legacy=True)]
     assert list(decode_frames(stale))[1]["error"] == "unmatched_legacy_reply"
+
+
+@pytest.mark.parametrize("legacy", [False, True], ids=["latest", "legacy"])
+def test_a_focus_reply_goes_to_the_command_of_its_sub_id(legacy: bool) -> None:
+    """Section 2.3.4.19: a focus motor reply's sub-ID is "与命令帧数据一致" (the same as the
+    command's). With a fixed reply SEQ, the calibration reply belongs to the calibration command
+    even though the position query (same CmdSet/CmdID) waits longer."""
+    frames = [*frames_of(FocusPositionQuery(), 1, 0x223, 1.0), *frames_of(FocusCalibration(), 2, 0x223, 1.001),
+              *frames_of(FocusCalibrationReply(0, 0x02, 0x00, 0x00), 0x99, 0x222, 1.002, legacy),
+              *frames_of(FocusPositionReply(0, 0x15, 0x00, 0x03, 4000), 0x99, 0x222, 1.003, legacy)]
+    replies = list(decode_frames(frames))[2:]
+    assert [(r.get("name"), r.get("request_seq")) for r in replies] == \
+        [("focus_calibration_reply", 2), ("focus_position_reply", 1)]
 
 
 def test_a_reply_answers_one_command_only() -> None:
