@@ -50,9 +50,9 @@ def open_can_bus(options: dict[str, Any]) -> can.BusABC:
             raise CliError(NO_INTERFACE) from None
         raise CliError(f"cannot open the CAN bus: unknown CAN interface: {_one_line(exc)}") from None
     where = f"{config['interface']} channel {config.get('channel')}"
-    try:
-        return can.Bus(**with_default_bitrate(options))
-    except (can.CanError, OSError, ValueError, ImportError) as exc:
+    try:  # the configuration read above, whole: can.Bus need not read the files again
+        return can.Bus(**with_default_bitrate({**config, "ignore_config": True}))
+    except (can.CanError, OSError, ValueError, ImportError, TypeError) as exc:  # TypeError: a missing channel
         raise CliError(f"cannot open the CAN bus ({where}): {_one_line(exc)}") from None
 
 

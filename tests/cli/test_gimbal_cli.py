@@ -206,17 +206,29 @@ def test_the_bitrate_is_the_documents_1_mbit_unless_given(
 
     monkeypatch.setattr(can, "Bus", fake_bus)
     assert main(["gimbal", "angles", "-i", "gs_usb", "-c", "0", *args]) == 2
-    assert opened == [{"interface": "gs_usb", "channel": "0", "bitrate": bitrate}]
+    # python-can's configuration, read once, is handed over whole (it makes a numeric channel an int)
+    assert opened == [{"interface": "gs_usb", "channel": 0, "bitrate": bitrate, "ignore_config": True}]
     assert "no adapter" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("args,words", [(["-i", "nosuchbus"], "unknown CAN interface"),
-                                        (["-i", "socketcan", "-c", "nosuchcan0"], "cannot open")])
+                                        (["-i", "socketcan", "-c", "nosuchcan0"], "cannot open"),
+                                        (["-i", "kvaser"], "argument: 'channel'")])  # once a TypeError traceback
 def test_bus_open_failures_are_one_line_errors(capsys: pytest.CaptureFixture[str], args: list[str],
                                                words: str) -> None:
     assert main(["gimbal", "angles", *args]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and words in err
+
+
+def test_python_cans_configuration_is_read_once_per_bus(monkeypatch: pytest.MonkeyPatch) -> None:
+    from pipelines.cli.bus import open_can_bus
+
+    real_load = can.util.load_config
+    loads: list[object] = []
+    monkeypatch.setattr(can.util, "load_config", lambda *a, **k: loads.append(a) or real_load(*a, **k))
+    open_can_bus({"interface": "virtual", "channel": "once"}).shutdown()
+    assert len(loads) == 1  # once for the error text, the default bitrate and can.Bus
 
 
 def test_watch_shows_the_attitude_of_a_short_push_timed_from_its_start(
