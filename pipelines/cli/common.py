@@ -36,10 +36,14 @@ def existing_dir(text: str) -> Path:
 
 
 def out_dir(text: str) -> Path:
-    """An ``--out`` folder; an empty one is refused (it would mean the current folder)."""
+    """An ``--out`` folder; an empty one is refused (it would mean the current folder), and so is
+    the filesystem root (a run's files scattered among the system's folders)."""
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path (use . for the current folder)")
-    return Path(text)
+    path = Path(text)
+    if path.resolve() == Path(path.resolve().anchor):
+        raise argparse.ArgumentTypeError(f"{text!r} is the filesystem root: give the outputs a folder of their own")
+    return path
 
 
 def parse_int(text: str) -> int:

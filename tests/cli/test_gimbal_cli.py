@@ -332,6 +332,16 @@ def test_model_and_output_folders_are_checked(tmp_path: Path) -> None:
         out_dir("")  # once the current folder
 
 
+@pytest.mark.parametrize("text", ["/", "//", "/tmp/..", "/./"])
+def test_the_filesystem_root_is_no_output_folder(text: str) -> None:
+    import argparse
+
+    from pipelines.cli.common import out_dir
+
+    with pytest.raises(argparse.ArgumentTypeError, match="filesystem root"):
+        out_dir(text)  # once five outputs written into / (as root)
+
+
 def test_logging_options_also_after_the_command(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["decode", "--hex", "AA", "--verbose"]) == 0
     assert main(["--verbose", "decode", "--hex", "AA"]) == 0
