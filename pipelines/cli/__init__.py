@@ -1,89 +1,26 @@
-"""The ``gimbaltrack`` command: one parser, one module per subcommand."""
+"""The ``gimbaltrack`` command. ``main`` is the console script; the parser and the run are in
+``pipelines.cli.app``, which ``main`` imports with Ctrl-C and the terminating signals held, so that
+one arriving while modules load is handled like any other (one line, no traceback, nothing lost).
+This module imports nothing but ``_signal`` (the C half of ``signal``, loaded with Python itself),
+keeping the time before ``main`` holds them as short as it can be; merely importing it changes no
+signal handling."""
 from __future__ import annotations
 
-import argparse
-import importlib
-import logging
-import os
-import sys
+import _signal
 
-from gimbal.signals import SignalExit, blocked_signals, exit_on_signals
-from pipelines.cli.common import EXIT_INTERRUPTED, CliError
-
-# Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
-SUBCOMMAND_MODULES = [
-    "pipelines.cli.eval_cmd",
-    "pipelines.cli.track_cmd",
-    "pipelines.cli.decode_cmd",
-    "pipelines.cli.replay_cmd",
-    "pipelines.cli.sim_cmd",
-    "pipelines.cli.gimbal_cmd",
-    "pipelines.cli.simulate_cmd",
-]
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="gimbaltrack",
-        description="Keep a subject framed with a DJI RS gimbal: track it in video, "
-        "turn its position into yaw/pitch rates, and drive the gimbal over CAN (DJI R SDK).",
-    )
-    _add_logging_options(parser, False)
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in SUBCOMMAND_MODULES:
-        importlib.import_module(name).register(subparsers)
-    pending = list(subparsers.choices.values())
-    while pending:  # after the command too, at any depth: gimbaltrack gimbal angles --debug
-        subparser = pending.pop()
-        _add_logging_options(subparser, argparse.SUPPRESS)
-        pending += [p for action in subparser._actions if isinstance(action, argparse._SubParsersAction)
-                    for p in action.choices.values()]
-    return parser
-
-
-def _add_logging_options(parser: argparse.ArgumentParser, default: object) -> None:
-    parser.add_argument("-v", "--verbose", action="store_true", default=default,
-                        help="log warnings too (retries, timeouts, best-effort stops)")
-    parser.add_argument("--debug", action="store_true", default=default, help="log debug output and show tracebacks")
-
-
-def quiet_opencv(argv: list[str]) -> None:
-    """Keep OpenCV's and FFmpeg's own warnings (``[ WARN:0@1.7] ...``, ``moov atom not found``) off
-    the terminal, where they bury the one-line error that explains them, unless ``--debug`` is
-    given or the variables are set already. Effective only before cv2 is imported."""
-    if "--debug" not in argv:
-        os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
-        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "8")  # AV_LOG_FATAL
+#: ``gimbal.signals``'s SIGINT and ``TERMINATING_SIGNALS``.
+HELD_SIGNALS = tuple(getattr(_signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT")
+                     if hasattr(_signal, name))
 
 
 def main(argv: list[str] | None = None) -> int:
-    prog = "gimbaltrack"
-    quiet_opencv(sys.argv[1:] if argv is None else argv)
+    """Run ``gimbaltrack`` with ``argv`` (default: the command line); its exit status."""
+    held = hasattr(_signal, "pthread_sigmask")
+    release = _signal.pthread_sigmask(_signal.SIG_BLOCK, HELD_SIGNALS) if held else None
     try:
-        with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
-            with blocked_signals():  # nor lost, or an import error, while numpy, SciPy and cv2 load
-                parser = build_parser()
-            args = parser.parse_args(argv)
-            prog = f"gimbaltrack {args.command}"
-            level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
-            logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
-            try:
-                return int(args.func(args) or 0)
-            except CliError as exc:
-                if args.debug:
-                    raise
-                print(f"{prog}: error: {exc}", file=sys.stderr)
-                return exc.exit_code
-    except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except SignalExit as exc:
-        print(f"{prog}: terminated ({exc.signal_name})", file=sys.stderr)
-        return int(exc.code)
-    except BrokenPipeError:  # the reader went away (e.g. `| head`): not an error of ours
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+        from pipelines.cli import app  # noqa: PLC0415 (imported here, under the hold)
+    except BaseException:
+        if release is not None:
+            _signal.pthread_sigmask(_signal.SIG_SETMASK, release)
+        raise
+    return app.main(argv, release=release)

@@ -11,7 +11,7 @@ from gimbal.messages import message_packet
 from gimbal.messages.motion import AnglesReply, GetAngles
 from gimbal.packet import encode_packet
 from gimbal.transport import packet_frames
-import pipelines.cli
+import pipelines.cli.app
 from pipelines.cli import main
 
 DOC_EXAMPLE = "AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE"
@@ -20,7 +20,7 @@ DOC_EXAMPLE = "AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14
 @pytest.fixture(autouse=True)
 def only_decode(monkeypatch: pytest.MonkeyPatch) -> None:
     """The real dispatcher, with only this subcommand (others' modules are not under test here)."""
-    monkeypatch.setattr(pipelines.cli, "SUBCOMMAND_MODULES", ["pipelines.cli.decode_cmd"])
+    monkeypatch.setattr(pipelines.cli.app, "SUBCOMMAND_MODULES", ["pipelines.cli.decode_cmd"])
 
 
 def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, list[dict], str]:
@@ -127,7 +127,7 @@ def test_a_log_without_frames_is_a_note_and_exit_0(command: str, tmp_path: Path,
                                                    capsys: pytest.CaptureFixture[str],
                                                    monkeypatch: pytest.MonkeyPatch) -> None:
     """decode and replay read logs through the same iter_log_frames."""
-    monkeypatch.setattr(pipelines.cli, "SUBCOMMAND_MODULES", [f"pipelines.cli.{command}_cmd"])
+    monkeypatch.setattr(pipelines.cli.app, "SUBCOMMAND_MODULES", [f"pipelines.cli.{command}_cmd"])
     path = tmp_path / "empty.log"
     path.write_text("")
     assert main([command, str(path)]) == 0

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-import pipelines.cli
+import pipelines.cli.app
 from pipelines.cli import main
 from pipelines.control.camera import DEFAULT_HFOV_DEG
 from tests import fake_onnx
@@ -19,7 +19,7 @@ from tests.support import ROOT, cli_command, signalled, subprocess_env, wait_unt
 @pytest.fixture(autouse=True)
 def only_simulate(monkeypatch: pytest.MonkeyPatch) -> None:
     """The real dispatcher, with only this subcommand (others' modules are not under test here)."""
-    monkeypatch.setattr(pipelines.cli, "SUBCOMMAND_MODULES", ["pipelines.cli.simulate_cmd"])
+    monkeypatch.setattr(pipelines.cli.app, "SUBCOMMAND_MODULES", ["pipelines.cli.simulate_cmd"])
 
 
 def simulate(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:

@@ -14,7 +14,8 @@ import pytest
 from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, ReturnCodeError
 from gimbal.messages.telemetry import ParameterPush
-from pipelines.cli import build_parser, main
+from pipelines.cli import main
+from pipelines.cli.app import build_parser
 from tests.support import ROOT, cli_command, free_udp_port, subprocess_env
 
 # Non-default ids, and a port of its own, keep this test apart from anything else using udp_multicast.

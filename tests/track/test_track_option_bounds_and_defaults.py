@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from pipelines.cli import build_parser, track_cmd
+from pipelines.cli import track_cmd
+from pipelines.cli.app import build_parser
 from pipelines.track_session import TrackOptions
 from tests.track.helpers import DEMO, DEMO_ROI, run_track
 

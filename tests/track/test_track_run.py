@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from gimbal.messages.camera import CameraActionCode
-from pipelines.cli import build_parser, track_cmd
+from pipelines.cli import track_cmd
+from pipelines.cli.app import build_parser
 from pipelines.control import ControlConfig
 from pipelines.outputs.telemetry import read_telemetry
 from pipelines.track_session import signed_attitude
