@@ -62,7 +62,7 @@ def quiet_opencv(argv: list[str]) -> None:
 def main(argv: list[str] | None = None, release: Iterable[int] | None = None) -> int:
     """Parse ``argv`` and run the subcommand; its exit status. ``release``: the signal mask to go
     back to once the handlers are in place, when the caller holds the signals already."""
-    prog = "gimbaltrack"
+    prog, debug = "gimbaltrack", False
     quiet_opencv(sys.argv[1:] if argv is None else argv)
     try:
         with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
@@ -73,11 +73,13 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
                 if release is not None:  # what arrived while the console script held them comes now
                     signal.pthread_sigmask(signal.SIG_SETMASK, release)
             args = parser.parse_args(argv)
-            prog = f"gimbaltrack {args.command}"
+            prog, debug = f"gimbaltrack {args.command}", args.debug
             level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
             logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
             try:
-                return int(args.func(args) or 0)
+                status = int(args.func(args) or 0)
+                sys.stdout.flush()  # a failure to write the results shows here, not at exit
+                return status
             except CliError as exc:
                 if args.debug:
                     raise
@@ -90,5 +92,19 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
         print(f"{prog}: terminated ({exc.signal_name})", file=sys.stderr)
         return int(exc.code)
     except BrokenPipeError:  # the reader went away (e.g. `| head`): not an error of ours
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        _drop_stdout()
         return 0
+    except OSError as exc:  # one no subcommand words itself, e.g. stdout on a full disk (> /dev/full)
+        if debug:
+            raise
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        try:
+            sys.stdout.flush()
+        except OSError:
+            _drop_stdout()
+        return 1
+
+
+def _drop_stdout() -> None:
+    """Point stdout at /dev/null, so that Python's own flush at exit cannot fail a second time."""
+    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
