@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import signal
 import threading
 import time
+from collections.abc import Callable
 from types import FrameType
 
 import can
@@ -103,8 +105,33 @@ def _window(text: str) -> tuple[float, float]:
     return window
 
 
+def _in_range(low: float, high: float, low_included: bool = True) -> Callable[[float], bool]:
+    """A test for finite numbers from ``low`` (or above it) to ``high``."""
+    return lambda v: math.isfinite(v) and (low <= v if low_included else low < v) and v <= high
+
+
+#: (option, attribute, what it takes, test): NaN fails every test.
+NUMBER_RULES: tuple[tuple[str, str, str, Callable[[float], bool]], ...] = (
+    ("--push-rate", "push_rate", "a finite rate above 0 Hz", _in_range(0, math.inf, False)),
+    ("--accel", "accel", "a finite acceleration above 0", _in_range(0, math.inf, False)),
+    ("--base-yaw", "base_yaw", "a finite angle", math.isfinite),
+    ("--calibration-time", "calibration_time", "a finite time, 0 s or more", _in_range(0, math.inf)),
+    ("--drop", "drop", "a fraction from 0 to 1", _in_range(0, 1)),
+    ("--corrupt", "corrupt", "a fraction from 0 to 1", _in_range(0, 1)),
+    ("--delay-ms", "delay_ms", "a finite delay, 0 ms or more", _in_range(0, math.inf)),
+    ("--nack", "nack", "a fraction from 0 to 1", _in_range(0, 1)),
+    ("--nack-code", "nack_code", "a byte, 0 to 0xFF", _in_range(0, 0xFF)),
+    ("--legacy-fraction", "legacy_fraction", "a fraction from 0 to 1", _in_range(0, 1)),
+    ("--foreign-rate", "foreign_rate", "a finite rate, 0 Hz or more", _in_range(0, math.inf)),
+    ("--status-interval", "status_interval", "a finite interval, 0 s or more", _in_range(0, math.inf)),
+)
+
+
 def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
     """The simulator's configuration and faults from the parsed options; ``CliError`` if invalid."""
+    for option, name, what, accepts in NUMBER_RULES:  # in the options' words, and NaN too
+        if not accepts(getattr(args, name)):
+            raise CliError(f"{option} takes {what}, not {getattr(args, name):g}")
     try:
         config = SimConfig(rx_id=args.tx_id, tx_id=args.rx_id, legacy=args.legacy,
                            push_rate_hz=args.push_rate, accel_dps2=args.accel, base_yaw_deg=args.base_yaw,
@@ -119,8 +146,6 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
         raise CliError(str(exc)) from None
     if args.duration is not None and args.duration <= 0:
         raise CliError(f"--duration must be positive, not {args.duration}")
-    if args.status_interval < 0:
-        raise CliError(f"--status-interval cannot be negative, not {args.status_interval}")
     if args.tx_id == args.rx_id:
         raise CliError(f"--tx-id and --rx-id must differ (both 0x{args.tx_id:03X})")
     return config, faults

@@ -115,8 +115,16 @@ def test_duration_status_lines_and_json(capsys) -> None:
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--drop", "1.5"], "Faults.drop is a fraction"),
-    (["--push-rate", "0"], "push_rate_hz must be positive"),
+    (["--drop", "1.5"], "--drop takes a fraction from 0 to 1, not 1.5"),
+    (["--push-rate", "0"], "--push-rate takes a finite rate above 0 Hz, not 0"),
+    # NaN once passed every check and stopped the simulator's threads; the words were SimConfig's
+    (["--delay-ms", "nan"], "--delay-ms takes a finite delay, 0 ms or more, not nan"),
+    (["--base-yaw", "nan"], "--base-yaw takes a finite angle, not nan"),
+    (["--foreign-rate", "nan"], "--foreign-rate takes a finite rate, 0 Hz or more, not nan"),
+    (["--push-rate", "inf"], "--push-rate takes a finite rate above 0 Hz, not inf"),
+    (["--calibration-time", "-1"], "--calibration-time takes a finite time, 0 s or more, not -1"),
+    (["--status-interval", "nan"], "--status-interval takes a finite interval, 0 s or more, not nan"),
+    (["--nack-code", "999"], "--nack-code takes a byte, 0 to 0xFF, not 999"),
     (["--duration", "0"], "--duration must be positive"),
     (["--tx-id", "0x222"], "must differ"),
     (["-i", "sim"], "in-process simulator"),
