@@ -18,6 +18,7 @@ from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_tra
 
 MAX_LATENCY_MS = 2000.0  # far beyond any pipeline worth simulating; a typo must not sleep for hours
 MAX_FPS = 1000.0
+MAX_SIDE = 8192  # pixels a side of the view: beyond 8K video, and a typo must not allocate gigabytes a frame
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -95,6 +96,8 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"--latency takes 0 to {MAX_LATENCY_MS:g} ms and --fps above 0 up to {MAX_FPS:g}")
     if args.fov is not None and not 0 < args.fov < 180:
         raise CliError(f"--fov takes 0 < DEG < 180, not {args.fov:g}")
+    if max(args.size) > MAX_SIDE:
+        raise CliError(f"--size takes at most {MAX_SIDE} pixels a side, not {args.size[0]}x{args.size[1]}")
     settings = LoopSettings(controller=args.controller, tracker=args.tracker, hfov_deg=args.fov,
                             out_size=args.size, latency_s=args.latency / 1000.0, fps=args.fps,
                             model_dir=args.model_dir)
@@ -111,8 +114,11 @@ def run(args: argparse.Namespace) -> int:
         raise
     summary = summary_of(result)
     if args.out:
-        write_plot(args.out / "plot.png", result)
-        write_summary(args.out / "summary.json", summary)
+        try:
+            write_plot(args.out / "plot.png", result)
+            write_summary(args.out / "summary.json", summary)
+        except OSError as exc:  # a full disk, a folder made read-only during the run
+            raise CliError(f"cannot write the results in {args.out}: {exc.strerror or exc}", exit_code=1) from None
     if args.json:
         print(json.dumps(summary))
         return 0

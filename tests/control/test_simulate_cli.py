@@ -81,6 +81,7 @@ def test_model_dir_reaches_the_tracker(sequence: Path, shared_data: Path,
     (["--tracker", "nanotrack", "--model-dir", "{empty}"], "NanoTrack: no nanotrack_backbone*.onnx in {empty}"),
     (["--fov", "180"], "--fov takes 0 < DEG < 180, not 180"),
     (["--latency", "inf"], "--latency takes 0 to 2000 ms and --fps above 0 up to 1000"),  # once a traceback
+    (["--size", "100000x100000"], "--size takes at most 8192 pixels a side, not 100000x100000"),  # once cv2.error
 ])
 def test_bad_options_fail_at_once_in_one_line(argv: list[str], message: str, sequence: Path, tmp_path: Path,
                                               capsys: pytest.CaptureFixture[str]) -> None:
@@ -95,6 +96,21 @@ def test_bad_options_fail_at_once_in_one_line(argv: list[str], message: str, seq
     assert code == 2 and stdout == ""
     assert err.startswith(f"gimbaltrack simulate: error: {message.format(file=file, empty=empty)}")
     assert err.count("\n") == 1
+
+
+def test_results_that_cannot_be_written_are_one_line_and_exit_1(sequence: Path, tmp_path: Path,
+                                                                 monkeypatch: pytest.MonkeyPatch,
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    import pipelines.cli.simulate_cmd
+
+    def full_disk(*args: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(pipelines.cli.simulate_cmd, "write_summary", full_disk)  # once a traceback
+    out = tmp_path / "out"
+    code, stdout, err = simulate([str(sequence), "--fps", "60", "--tracker", "oracle", "--out", str(out)], capsys)
+    assert code == 1 and stdout == ""
+    assert err == f"gimbaltrack simulate: error: cannot write the results in {out}: No space left on device\n"
 
 
 @pytest.mark.parametrize("backbone, head, wrong", [
