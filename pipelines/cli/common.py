@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
@@ -25,6 +26,8 @@ def make_out_dir(out: Path) -> None:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise CliError(f"cannot create output folder {out}: {exc.strerror}") from None
+    if not os.access(out, os.W_OK | os.X_OK):  # read-only (a mount, a mode): say so now, not after the run
+        raise CliError(f"cannot write in output folder {out}: read-only or no permission")
 
 
 def existing_dir(text: str) -> Path:

@@ -113,6 +113,21 @@ def test_results_that_cannot_be_written_are_one_line_and_exit_1(sequence: Path, 
     assert err == f"gimbaltrack simulate: error: cannot write the results in {out}: No space left on device\n"
 
 
+def test_a_read_only_output_folder_fails_before_the_run(sequence: Path, tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    import os
+
+    out = tmp_path / "out"
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda path, mode: path != out and real_access(path, mode))  # as on a ro mount
+    started = time.monotonic()
+    code, stdout, err = simulate([str(sequence), "--fps", "1", "--out", str(out)], capsys)  # 12 s of run
+    assert time.monotonic() - started < 6  # once found only when the results were written, as a traceback
+    assert (code, stdout) == (2, "")
+    assert err == f"gimbaltrack simulate: error: cannot write in output folder {out}: read-only or no permission\n"
+
+
 @pytest.mark.parametrize("backbone, head, wrong", [
     (b"junk!", fake_onnx.head_bytes(), "nanotrack_backbone_sim.onnx: not a readable ONNX network"),
     (fake_onnx.head_bytes(), fake_onnx.backbone_bytes(), "nanotrack_backbone_sim.onnx: not NanoTrack's backbone"),
