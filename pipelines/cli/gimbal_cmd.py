@@ -29,7 +29,7 @@ from gimbal.messages.settings import (LIMIT_RANGES, ActiveTrack, GetAngleLimits,
                                       SetMotorStiffness, SetWorkMode, SELFIE)
 from gimbal.messages.telemetry import (PUSH_DISABLE, PUSH_ENABLE, ParameterPush, PushControl,
                                        VersionPush, VersionQuery)
-from gimbal.messages.tlv_params import (ROLL360_MODES, AutoCalibration, CalibrationStatusPush,
+from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoCalibration, CalibrationStatusPush,
                                         GetUserParams, SetUserParams, Tlv, autotune,
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
@@ -111,7 +111,7 @@ def describe_push(message: Message, t: float) -> Result:
         if message.stiffness_valid:
             out["stiffness"] = {a: getattr(message, f"{a}_stiffness") for a in STIFFNESS}
     elif isinstance(message, CalibrationStatusPush):
-        out.update(state=message.state, progress=message.progress)
+        out.update(state=CALIBRATION_STATES.get(message.state, message.state), progress=message.progress)
     else:
         out.update(message.fields())
     return out

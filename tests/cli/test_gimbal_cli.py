@@ -19,7 +19,7 @@ from gimbal.messages.external import FocusCalibration, FocusCalibrationReply
 from gimbal.messages.motion import AnglesReply, GetAngles, PositionControl, SpeedControl
 from gimbal.messages.settings import AngleLimitsReply, GetAngleLimits, SetAngleLimits
 from gimbal.messages.telemetry import ParameterPush, PushControl, PushControlReply
-from gimbal.messages.tlv_params import SetUserParams, SetUserParamsReply, Tlv
+from gimbal.messages.tlv_params import CalibrationStatusPush, SetUserParams, SetUserParamsReply, Tlv
 from pipelines.cli import main
 from pipelines.cli.gimbal_cmd import register
 from tests.gimbal.scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages
@@ -242,6 +242,20 @@ def test_watch_shows_the_attitude_of_a_short_push_timed_from_its_start(
     first = json.loads(capsys.readouterr().out.splitlines()[0])
     assert first["push"] == "parameter_push" and first["t"] >= 0
     assert first["attitude"] == {"yaw": 3.2, "roll": 4.8, "pitch": 6.4} and "joint" not in first
+
+
+def test_watch_names_the_calibration_state(channel: str, peer: ScriptedPeer,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    """Figure 30's states by name (0 idle, 1 running, 2 done, 3 error), not as a bare number."""
+    def push_then_reply(message: Message) -> Message:
+        peer.push(CalibrationStatusPush.of(1, 40))
+        return PushControlReply()
+
+    peer.answer(PushControl, push_then_reply)
+    assert gimbal(channel, "watch", "--duration", "0.3", "--json") == 0
+    pushes = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    status = next(p for p in pushes if p["push"] == "calibration_status_push")
+    assert (status["state"], status["progress"]) == ("running", 40)
 
 
 def test_the_range_error_in_the_docs_is_what_the_cli_prints(capsys: pytest.CaptureFixture[str]) -> None:
