@@ -120,7 +120,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
     detect = args.detect or (None if roi else DEFAULT_DETECTOR)
     return TrackOptions(
         out_dir=args.out, roi=roi, detect=detect,
-        pick=args.pick or ("largest" if detect == "motion" else "central"), tracker=args.tracker, model_dir=args.model_dir, controller=args.controller,
+        pick=args.pick or ("largest" if detect == "motion" else "central"),
+        tracker=args.tracker, model_dir=args.model_dir, controller=args.controller,
         hfov_deg=args.hfov, rate_hz=args.rate, max_speed_dps=args.max_speed, record=args.record,
         realtime=args.realtime, attitude_feedback=args.attitude_feedback,
         yaw_sign=-1 if args.invert_yaw else 1, pitch_sign=-1 if args.invert_pitch else 1,
