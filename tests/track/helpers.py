@@ -59,6 +59,17 @@ def drifting(i: int) -> tuple[int, int]:
     return 140 + i, 100
 
 
+def out_right_and_back(back_at: int, y: int) -> Position:
+    """A subject walking right at 6 px a frame from x = 140 until it is out of view (frame 30 on),
+    then from frame ``back_at`` coming back in from the right at the same speed, at height ``y``."""
+    def position(i: int) -> tuple[int, int] | None:
+        if i < back_at:
+            x = 140 + 6 * i
+            return (x, y) if x < SIZE[0] else None
+        return SIZE[0] - 6 * (i - back_at), y
+    return position
+
+
 def roi_at(position: Position) -> str:
     x, y = position(0)  # type: ignore[misc]
     return f"{x},{y},{BOX},{BOX}"

@@ -6,17 +6,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from pipelines.outputs.telemetry import read_telemetry
-from tests.track.helpers import BOX, SIZE, make_clip, run_track
+from tests.track.helpers import BOX, make_clip, out_right_and_back, run_track
 from tracker.boxes import iou
 
 BACK_AT = 60  # the frame where the subject starts to come back in from the right
 
 
-def _subject(i: int) -> tuple[int, int] | None:
-    if i < BACK_AT:
-        x = 140 + 6 * i
-        return (x, 60) if x < SIZE[0] else None  # out of view from frame 30 on
-    return SIZE[0] - 6 * (i - BACK_AT), 60
+_subject = out_right_and_back(BACK_AT, 60)
 
 
 def _other(i: int) -> tuple[int, int] | None:

@@ -10,16 +10,12 @@ import pytest
 
 import pipelines.track_session
 from pipelines.outputs.telemetry import read_telemetry
-from tests.track.helpers import BOX, SIZE, make_clip, run_track
+from tests.track.helpers import BOX, make_clip, out_right_and_back, run_track
 
 BACK_AT = 50  # the frame where the subject starts to come back in from the right
 
 
-def _position(i: int) -> tuple[int, int] | None:
-    if i < BACK_AT:
-        x = 140 + 6 * i
-        return (x, 100) if x < SIZE[0] else None  # out of view from frame 30 on
-    return SIZE[0] - 6 * (i - BACK_AT), 100
+_position = out_right_and_back(BACK_AT, 100)
 
 
 def test_the_detector_runs_only_without_a_subject_and_finds_it_again(
