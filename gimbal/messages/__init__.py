@@ -51,8 +51,9 @@ def is_device_push(packet: Packet) -> bool:
 def reply_fits(reply_cls: type[Message], payload: bytes) -> bool:
     """Whether ``payload`` can be a ``reply_cls`` reply: the focus motor replies (0x0E/0x12) echo
     the command's sub-ID (section 2.3.4.19: 与命令帧数据一致, "the same as in the command"); a
-    reply carrying its return code alone fits any."""
-    return len(payload) < 2 or reply_cls.matches(payload)
+    reply carrying its return code alone, or a non-zero one (a NACK need not echo the rest), fits
+    any."""
+    return len(payload) < 2 or payload[0] != 0 or reply_cls.matches(payload)
 
 
 def decode_message(packet: Packet, request: type[Message] | Message | None = None) -> Message:

@@ -10,7 +10,7 @@ from collections.abc import Iterator
 import pytest
 
 from gimbal.client import GimbalClient
-from gimbal.errors import PayloadError
+from gimbal.errors import PayloadError, ReturnCodeError
 from gimbal.messages import decode_message
 from gimbal.messages.external import (FocusCalibration, FocusPositionQuery,
                                       FocusPositionReply)
@@ -53,3 +53,23 @@ def test_a_gimbal_that_does_not_echo_seq_pairs_focus_replies_by_sub_id(
     assert isinstance(reply, FocusPositionReply)
     assert (reply.calibration_state, reply.position) == (0x03, 4000)
     assert client.stats["stale_replies"] == 1
+
+
+NACK_WITHOUT_SUB_ID = bytes((0x01, 0x00, 0x00, 0x00))  # return code 0x01, the other fields zero
+
+
+@pytest.mark.parametrize("legacy", [False, True], ids=["latest", "legacy"])
+def test_a_nack_answers_its_command_whatever_follows_its_return_code(legacy: bool) -> None:
+    """An error reply need not echo the sub-command: its return code is the answer (it was
+    refused as 'another sub-command's reply', and the client then waited for a reply it had)."""
+    packet = Packet.reply(0x0E, 0x12, NACK_WITHOUT_SUB_ID, seq=1, legacy=legacy)
+    assert decode_message(packet, FocusCalibration()).return_code == 0x01
+
+
+def test_the_client_reports_a_focus_nack_that_does_not_echo_the_sub_id(
+        client: GimbalClient, peer: ScriptedPeer) -> None:
+    waiter = client.submit(FocusCalibration())
+    peer.transport.send(Packet.reply(0x0E, 0x12, NACK_WITHOUT_SUB_ID, seq=waiter.seq))
+    assert waiter.wait(2.0)
+    with pytest.raises(ReturnCodeError):
+        client.result(waiter)
