@@ -44,7 +44,8 @@ def out_dir(text: str) -> Path:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path (use . for the current folder)")
     path = Path(text)
-    if path.resolve() == Path(path.resolve().anchor):
+    real = Path(os.path.realpath(path))  # not Path.resolve(): a symlink loop raises RuntimeError there
+    if real == Path(real.anchor):
         raise argparse.ArgumentTypeError(f"{text!r} is the filesystem root: give the outputs a folder of their own")
     return path
 

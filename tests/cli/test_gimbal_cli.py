@@ -356,6 +356,13 @@ def test_the_filesystem_root_is_no_output_folder(text: str) -> None:
         out_dir(text)  # once five outputs written into / (as root)
 
 
+def test_an_output_folder_in_a_symlink_loop_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The root check resolved the path, and a symlink loop made that a RuntimeError traceback."""
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    assert main(["simulate", str(tmp_path), "--out", str(tmp_path / "loop" / "x")]) == 2
+    assert "cannot create output folder" in capsys.readouterr().err
+
+
 def test_logging_options_also_after_the_command(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["decode", "--hex", "AA", "--verbose"]) == 0
     assert main(["--verbose", "decode", "--hex", "AA"]) == 0
