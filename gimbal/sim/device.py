@@ -213,7 +213,8 @@ class SimulatedGimbal:
             last = now
             if foreign:
                 self._bus_send([can.Message(arbitration_id=i, is_extended_id=False, data=d) for i, d in foreign])
-            self._wake.wait(None if until is None else max(0.0, until - self.clock()))
+            # at most TIMEOUT_MAX: a longer wait (--delay-ms 1e300) is an OverflowError that ends the thread
+            self._wake.wait(None if until is None else min(max(0.0, until - self.clock()), threading.TIMEOUT_MAX))
 
     def _next_due(self) -> float | None:
         """When the next push or delayed reply is due (lock held)."""

@@ -7,7 +7,7 @@ import pytest
 
 from gimbal.errors import GimbalError, GimbalTimeoutError, ReturnCodeError
 from gimbal.messages import message_packet, motion
-from gimbal.messages.telemetry import PUSH_ENABLE, PushControl
+from gimbal.messages.telemetry import PUSH_ENABLE, ParameterPush, PushControl
 from gimbal.packet import encode_packet
 from gimbal.sim import Faults
 from tests.sim.helpers import wait_until
@@ -120,3 +120,14 @@ def test_the_same_seed_loses_the_same_replies_whatever_the_pushes_draw(make_clie
 
     first = outcomes()
     assert "x" in first and "." in first and outcomes() == first
+
+
+def test_a_delay_beyond_what_a_thread_can_wait_keeps_the_simulator_running(make_client) -> None:
+    """``sim --delay-ms 1e300`` passes the finite-number check; the tick thread's wait until that
+    reply was due overflowed (OverflowError traceback) and it died: no pushes from then on."""
+    client, sim = make_client(faults=Faults(delay_s=1e297), timeout=0.1, retries=0)
+    with pytest.raises(GimbalTimeoutError):
+        client.version()  # its reply queued for 1e297 s, nothing else due
+    with pytest.raises(GimbalTimeoutError):
+        client.set_push(True)  # executed at once, its reply queued too
+    client.wait_for_push(ParameterPush, 2.0)
