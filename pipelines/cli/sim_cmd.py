@@ -184,7 +184,8 @@ def run(args: argparse.Namespace) -> int:
             next_status = start + args.status_interval if args.status_interval else None
             while True:
                 due = [t for t in (deadline, next_status) if t is not None]
-                if stop.wait(max(0.0, min(due) - time.monotonic()) if due else None):
+                wait = min(max(0.0, min(due) - time.monotonic()), threading.TIMEOUT_MAX) if due else None
+                if stop.wait(wait):  # at most TIMEOUT_MAX: --status-interval 1e300 overflowed
                     break
                 now = time.monotonic()
                 if deadline is not None and now >= deadline:

@@ -6,6 +6,7 @@ import os
 import random
 import signal
 import subprocess
+import threading
 import time
 from collections.abc import Iterator
 
@@ -142,3 +143,10 @@ def test_malformed_options_are_usage_errors(capsys, args: list[str]) -> None:
     with pytest.raises(SystemExit) as exc:
         main(["sim", *args])
     assert exc.value.code == 2
+
+
+def test_a_status_interval_beyond_what_a_thread_can_wait_runs_until_stopped(capsys) -> None:
+    """``--status-interval 1e300`` passes the finite-number check; waiting for that status line
+    was an OverflowError traceback at once."""
+    threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGTERM)).start()  # to the process, as `kill` does
+    assert main(["sim", "-i", "virtual", "-c", f"sim-cli-{os.getpid()}", "--status-interval", "1e300"]) == 0
