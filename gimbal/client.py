@@ -11,7 +11,7 @@ in a row that could only be paired by command (a gimbal with a fixed SEQ or its 
 of which matched by chance) switch that back. Before the first echo, a reply to another host on
 a shared bus cannot be told from a non-echoing gimbal's and is paired by command; when our own
 reply then arrives echoing our SEQ, echoing is learnt (``misattributed_replies``), so that costs
-one request, not every one.
+the requests then waiting for that command (usually one), not every later one.
 A retry resends the *same* packet with the same SEQ, so a late reply to any attempt completes the
 call. Commands whose repetition changes the outcome (relative moves, toggles, camera actions)
 are never retried. Replies that match no outstanding request (``stale_replies``), or are too short
