@@ -78,7 +78,10 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
             logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
             try:
                 status = int(args.func(args) or 0)
-                sys.stdout.flush()  # a failure to write the results shows here, not at exit
+                try:
+                    sys.stdout.flush()  # a failure to write the results shows here, not at exit
+                except BrokenPipeError:  # the reader left: the run's own status still stands (130, ...)
+                    _drop_stdout()
                 return status
             except CliError as exc:
                 if args.debug:
