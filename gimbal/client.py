@@ -299,7 +299,8 @@ class GimbalClient:
         except BaseException as exc:  # recorded, and re-raised as BusError on the next call
             if self._closing.is_set():
                 return
-            self._rx_error = exc
+            with self._tx_lock:  # a command already past its checks is on the bus before the stop
+                self._rx_error = exc
             log.error("gimbal receive thread stopped: %r", exc)
             self._fail_all(exc)
             self.pushes.interrupt(BusError(f"the receive thread stopped: {exc}"))

@@ -590,3 +590,34 @@ def test_sys_exit_in_a_push_callback_stops_the_gimbal_and_says_so(client: Gimbal
     poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])
     with pytest.raises(BusError, match=r"push callback .* raised SystemExit\(\)"):
         client.get_angles()
+
+
+def test_the_stop_on_a_lost_bus_comes_after_a_command_already_being_sent(channel: str, peer: ScriptedPeer) -> None:
+    """A command another thread is sending when the receive side dies goes out before the
+    safety stop, not after it: otherwise the gimbal would run at that speed for its 0.5 s."""
+    gimbal = GimbalClient(FlakyBus(channel=channel), timeout=0.2, retries=0)
+    peer.answer(SpeedControl)
+    gimbal.speed(0, 15)
+    send, arrived, go = gimbal.transport.send, threading.Event(), threading.Event()
+
+    def held_send(raw: bytes) -> bytes:
+        if threading.current_thread().name == "user":
+            arrived.set()  # past the client's checks, on its way to the bus
+            go.wait(5.0)
+        return send(raw)
+
+    gimbal.transport.send = held_send  # type: ignore[method-assign]
+    user = threading.Thread(target=lambda: pytest.raises(GimbalError, gimbal.speed, 30, 0), name="user")
+    user.start()
+    try:
+        assert arrived.wait(5.0)
+        gimbal.bus.fail_recv = True
+        time.sleep(0.6)  # the receive thread gives up after RX_GIVE_UP_S and stops the gimbal
+        go.set()
+        user.join(5.0)
+        poll(lambda: len(speed_messages(peer)) == 4)
+        assert speed_messages(peer)[1:] == [(300, 0, 0, ZERO[3]), ZERO, RELEASE]
+    finally:
+        go.set()
+        gimbal.close()
+        gimbal.bus.shutdown()
