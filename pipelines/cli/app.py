@@ -100,7 +100,7 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     except OSError as exc:  # one no subcommand words itself, e.g. stdout on a full disk (> /dev/full)
         if debug:
             raise
-        print(f"{prog}: error: {exc}", file=sys.stderr)
+        print(f"{prog}: error: {str(exc) or type(exc).__name__}", file=sys.stderr)  # TimeoutError() says nothing
         try:
             sys.stdout.flush()
         except OSError:

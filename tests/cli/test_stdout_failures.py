@@ -42,3 +42,12 @@ def test_a_broken_pipe_at_the_end_keeps_the_runs_exit_status(tmp_path: Path, mon
         monkeypatch.setattr(sys, "stdout", ReaderGone(target.fileno()))
         monkeypatch.setattr(pipelines.cli.decode_cmd, "run", lambda args: 130)  # e.g. track after Ctrl-C
         assert main(["decode", "--hex", "AA"]) == 130
+
+
+def test_an_oserror_without_words_is_named(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    def run(args: object) -> int:
+        raise TimeoutError
+
+    monkeypatch.setattr(pipelines.cli.decode_cmd, "run", run)
+    assert main(["decode", "--hex", "AA"]) == 1
+    assert capsys.readouterr().err == "gimbaltrack decode: error: TimeoutError\n"
