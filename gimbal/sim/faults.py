@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 DIRECTIONS = ("both", "rx", "tx")
 FOREIGN_IDS = (0x530, 0x531, 0x426)  # DJI's internal accessory traffic seen on live buses
+MAX_FOREIGN_RATE_HZ = 20_000  # more frames than a 1 Mbit/s classic CAN bus carries (~9,000-18,000/s)
 #: The RNG streams: frames received, reply frames, push frames, NACKs, legacy replies, foreign traffic.
 STREAMS = ("rx", "replies", "pushes", "nack", "legacy", "foreign")
 
@@ -36,8 +37,10 @@ class Faults:
                 raise ValueError(f"Faults.{name} is a fraction in 0..1, not {value}")
         if self.direction not in DIRECTIONS:
             raise ValueError(f"Faults.direction must be one of {', '.join(DIRECTIONS)}, not {self.direction!r}")
-        if self.delay_s < 0 or self.foreign_rate < 0:
-            raise ValueError("Faults.delay_s and Faults.foreign_rate cannot be negative")
+        if self.delay_s < 0:
+            raise ValueError("Faults.delay_s cannot be negative")
+        if not 0 <= self.foreign_rate <= MAX_FOREIGN_RATE_HZ:
+            raise ValueError(f"Faults.foreign_rate is 0 to {MAX_FOREIGN_RATE_HZ} frames/s, not {self.foreign_rate}")
         if not 0 <= self.nack_code <= 0xFF:
             raise ValueError(f"Faults.nack_code {self.nack_code} does not fit a byte")
         if self.silent is not None and not 0 <= self.silent[0] <= self.silent[1]:

@@ -15,7 +15,7 @@ import can
 
 from gimbal.messages.motion import AXES
 from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
-from gimbal.sim.faults import DIRECTIONS
+from gimbal.sim.faults import DIRECTIONS, MAX_FOREIGN_RATE_HZ
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
 
@@ -122,7 +122,8 @@ NUMBER_RULES: tuple[tuple[str, str, str, Callable[[float], bool]], ...] = (
     ("--nack", "nack", "a fraction from 0 to 1", _in_range(0, 1)),
     ("--nack-code", "nack_code", "a byte, 0 to 0xFF", _in_range(0, 0xFF)),
     ("--legacy-fraction", "legacy_fraction", "a fraction from 0 to 1", _in_range(0, 1)),
-    ("--foreign-rate", "foreign_rate", "a finite rate, 0 Hz or more", _in_range(0, math.inf)),
+    ("--foreign-rate", "foreign_rate", f"a rate from 0 to {MAX_FOREIGN_RATE_HZ} Hz (a 1 Mbit/s bus carries less)",
+     _in_range(0, MAX_FOREIGN_RATE_HZ)),
     ("--status-interval", "status_interval", "a finite interval, 0 s or more", _in_range(0, math.inf)),
 )
 

@@ -131,3 +131,10 @@ def test_a_delay_beyond_what_a_thread_can_wait_keeps_the_simulator_running(make_
     with pytest.raises(GimbalTimeoutError):
         client.set_push(True)  # executed at once, its reply queued too
     client.wait_for_push(ParameterPush, 2.0)
+
+
+@pytest.mark.parametrize("rate", [-1.0, 20_001.0, 1e300])
+def test_foreign_traffic_is_bounded_by_what_a_bus_carries(rate: float) -> None:
+    """1e300 frames/s was taken, and the tick thread then built that many frames at once."""
+    with pytest.raises(ValueError, match="foreign_rate"):
+        Faults(foreign_rate=rate)

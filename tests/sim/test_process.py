@@ -115,13 +115,17 @@ def test_duration_status_lines_and_json(capsys) -> None:
     assert json.loads(lines[-1])["motors_on"] is True
 
 
+FOREIGN_RATE = "--foreign-rate takes a rate from 0 to 20000 Hz (a 1 Mbit/s bus carries less)"
+
+
 @pytest.mark.parametrize("args, message", [
     (["--drop", "1.5"], "--drop takes a fraction from 0 to 1, not 1.5"),
     (["--push-rate", "0"], "--push-rate takes a finite rate above 0 Hz, not 0"),
     # NaN once passed every check and stopped the simulator's threads; the words were SimConfig's
     (["--delay-ms", "nan"], "--delay-ms takes a finite delay, 0 ms or more, not nan"),
     (["--base-yaw", "nan"], "--base-yaw takes a finite angle, not nan"),
-    (["--foreign-rate", "nan"], "--foreign-rate takes a finite rate, 0 Hz or more, not nan"),
+    (["--foreign-rate", "nan"], f"{FOREIGN_RATE}, not nan"),
+    (["--foreign-rate", "1e300"], f"{FOREIGN_RATE}, not 1e+300"),  # once let through: that many frames a tick
     (["--push-rate", "inf"], "--push-rate takes a finite rate above 0 Hz, not inf"),
     (["--calibration-time", "-1"], "--calibration-time takes a finite time, 0 s or more, not -1"),
     (["--status-interval", "nan"], "--status-interval takes a finite interval, 0 s or more, not nan"),
