@@ -365,10 +365,9 @@ class GimbalClient:
         """
         key = reply_key(packet)
         legacy = key is None
-        payload = packet.data if legacy else packet.data[2:]
 
         def answers(w: PendingReply) -> bool:
-            return (legacy or w.key == key) and reply_fits(w.request.REPLY, payload)
+            return (legacy or w.key == key) and reply_fits(w.request.REPLY, packet)
 
         with self._lock:
             waiter = self._pending.get(packet.seq)

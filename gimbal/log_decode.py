@@ -141,12 +141,11 @@ class LogDecoder:
         """Remove and return the outstanding command a reply answers, if any was seen."""
         self._expire(timestamp)
         key = None if legacy else (_byte(packet.data, 0), _byte(packet.data, 1))
-        payload = packet.data if legacy else packet.data[2:]
 
         def answers(entry: _Outstanding) -> bool:
             request = entry.message
             return (key is None or (request.CMD_SET, request.CMD_ID) == key) \
-                and reply_fits(request.REPLY, payload)  # a focus reply: its command's sub-ID
+                and reply_fits(request.REPLY, packet)  # a focus reply: its command's sub-ID
 
         candidates = [e for e in self._outstanding if answers(e)]
         match = next((e for e in candidates if e.seq == packet.seq), None) or \

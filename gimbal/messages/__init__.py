@@ -48,11 +48,12 @@ def is_device_push(packet: Packet) -> bool:
     return len(data) >= 2 and (data[0], data[1]) in DEVICE_PUSHES
 
 
-def reply_fits(reply_cls: type[Message], payload: bytes) -> bool:
-    """Whether ``payload`` can be a ``reply_cls`` reply: the focus motor replies (0x0E/0x12) echo
-    the command's sub-ID (section 2.3.4.19: 与命令帧数据一致, "the same as in the command"); a
-    reply carrying its return code alone, or a non-zero one (a NACK need not echo the rest), fits
-    any."""
+def reply_fits(reply_cls: type[Message], packet: Packet) -> bool:
+    """Whether the reply ``packet`` (either layout) can be a ``reply_cls`` reply: the focus motor
+    replies (0x0E/0x12) echo the command's sub-ID (section 2.3.4.19: 与命令帧数据一致, "the same as
+    in the command"); a reply carrying its return code alone, or a non-zero one (a NACK need not
+    echo the rest), fits any."""
+    payload = packet.data if is_legacy_reply(packet) else packet.data[2:]
     return len(payload) < 2 or payload[0] != 0 or reply_cls.matches(payload)
 
 
@@ -86,7 +87,7 @@ def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Me
         key, payload = (request.CMD_SET, request.CMD_ID), packet.data
     expected = getattr(request, "REPLY", None)
     if expected is not None and (expected.CMD_SET, expected.CMD_ID) == key:
-        if not reply_fits(expected, payload):
+        if not reply_fits(expected, packet):
             raise PayloadError(f"{expected.NAME}: payload {payload.hex(' ')} is another sub-command's "
                                "reply (its sub-ID does not echo the command's)")
         return expected.decode_payload(payload)
