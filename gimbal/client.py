@@ -367,7 +367,7 @@ class GimbalClient:
         legacy = key is None
 
         def answers(w: PendingReply) -> bool:
-            return (legacy or w.key == key) and reply_fits(w.request.REPLY, packet)
+            return (legacy or w.key == key) and reply_fits(w.request, packet)
 
         with self._lock:
             waiter = self._pending.get(packet.seq)

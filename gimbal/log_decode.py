@@ -145,7 +145,7 @@ class LogDecoder:
         def answers(entry: _Outstanding) -> bool:
             request = entry.message
             return (key is None or (request.CMD_SET, request.CMD_ID) == key) \
-                and reply_fits(request.REPLY, packet)  # a focus reply: its command's sub-ID
+                and reply_fits(request, packet)  # a focus sub-ID, a version device ID
 
         candidates = [e for e in self._outstanding if answers(e)]
         match = next((e for e in candidates if e.seq == packet.seq), None) or \

@@ -48,13 +48,16 @@ def is_device_push(packet: Packet) -> bool:
     return len(data) >= 2 and (data[0], data[1]) in DEVICE_PUSHES
 
 
-def reply_fits(reply_cls: type[Message], packet: Packet) -> bool:
-    """Whether the reply ``packet`` (either layout) can be a ``reply_cls`` reply: the focus motor
-    replies (0x0E/0x12) echo the command's sub-ID (section 2.3.4.19: 与命令帧数据一致, "the same as
-    in the command"); a reply carrying its return code alone, or a non-zero one (a NACK need not
-    echo the rest), fits any."""
+def reply_fits(request: type[Message] | Message, packet: Packet) -> bool:
+    """Whether the reply ``packet`` (either layout) can answer ``request`` (a command, or its
+    class): the focus motor replies (0x0E/0x12) echo the command's sub-ID (section 2.3.4.19:
+    与命令帧数据一致, "the same as in the command"); a reply carrying its return code alone, or a
+    non-zero one (a NACK need not echo the rest), fits any. A command instance also checks what
+    its reply names (``Message.reply_is_mine``: the version query's device ID)."""
     payload = packet.data if is_legacy_reply(packet) else packet.data[2:]
-    return len(payload) < 2 or payload[0] != 0 or reply_cls.matches(payload)
+    if len(payload) >= 2 and payload[0] == 0 and not request.REPLY.matches(payload):
+        return False
+    return isinstance(request, type) or request.reply_is_mine(payload)
 
 
 def decode_message(packet: Packet, request: type[Message] | Message | None = None) -> Message:
@@ -87,9 +90,9 @@ def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Me
         key, payload = (request.CMD_SET, request.CMD_ID), packet.data
     expected = getattr(request, "REPLY", None)
     if expected is not None and (expected.CMD_SET, expected.CMD_ID) == key:
-        if not reply_fits(expected, packet):
-            raise PayloadError(f"{expected.NAME}: payload {payload.hex(' ')} is another sub-command's "
-                               "reply (its sub-ID does not echo the command's)")
+        if not reply_fits(request, packet):
+            raise PayloadError(f"{expected.NAME}: payload {payload.hex(' ')} answers another command "
+                               f"than this {request.NAME} (another sub-ID or device ID)")
         return expected.decode_payload(payload)
     if key not in REPLIES:
         raise UnknownMessageError(f"reply to 0x{key[0]:02X}/0x{key[1]:02X}: the document defines none")

@@ -85,6 +85,11 @@ class Message:
         """Whether ``payload`` is this message rather than a sibling on the same CmdSet/CmdID."""
         return True
 
+    def reply_is_mine(self, reply_payload: bytes) -> bool:
+        """Whether a reply payload (return code first) answers this very command rather than
+        another of its class (a version reply names the device asked about); True by default."""
+        return True
+
     def validate(self) -> None:
         """Raise ``RangeError`` for any field outside the document's range."""
         layout = _layout(type(self))

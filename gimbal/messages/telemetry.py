@@ -132,6 +132,15 @@ class VersionQuery(Command):
     def matches(cls, payload: bytes) -> bool:
         return len(payload) < 8
 
+    def reply_is_mine(self, reply_payload: bytes) -> bool:
+        """The reply names the device whose version it carries (2.3.4.10, 设备 ID at byte 1): a
+        reply naming another answers another query. A NACK may name none (code alone, or 0,
+        reserved by 2.3.3)."""
+        if len(reply_payload) < 5:
+            return True
+        named = int.from_bytes(reply_payload[1:5], "little")
+        return named == self.device_id or (reply_payload[0] != 0 and named == DEVICE_ID_RESERVED)
+
 
 @register
 @dataclass
