@@ -360,7 +360,8 @@ class GimbalClient:
         By SEQ first. Unless the gimbal is known to echo SEQs, a reply whose SEQ matches
         nothing goes to the oldest request with its CmdSet/CmdID (latest layout) or to the oldest
         request (legacy layout); for a gimbal that echoes, such a reply is stale. A focus motor
-        reply (0x12) only answers a request of the sub-command it echoes. Raises
+        reply (0x12) only answers a request of the sub-command it echoes, a version reply (0x09)
+        only the query for the device it names (``reply_fits``). Raises
         ``PayloadError`` for a reply too short to say which command it answers.
         """
         key = reply_key(packet)
