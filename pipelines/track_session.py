@@ -180,9 +180,7 @@ class TrackSession:
             self.first_acquired_s = time.monotonic() - self._started
             if self.options.record:
                 self._start_recording()
-        self.frames += 1
         state = estimate.state.value if estimate is not None else "acquiring"
-        self.states[state] += 1
         self._write_frame(frame, stamp, state, estimate, command)
         if self.can_log is not None and self.can_log.error is not None:
             raise OSError(f"cannot write the CAN log {self.can_log.path}: {self.can_log.error}")
@@ -225,6 +223,8 @@ class TrackSession:
 
     def _write_frame(self, frame: Frame, stamp: float, state: str, estimate: TargetEstimate | None,
                      command: Any) -> None:
+        """Telemetry first, then the frame is counted (summary and plot), then the video: the
+        summary's ``frames`` are the telemetry's lines, whichever output fails."""
         attitude = self.history.latest()
         record: dict[str, Any] = {"frame": frame.index, "t": stamp,
                                   "t_run": time.monotonic() - self._started, "state": state}
@@ -240,16 +240,8 @@ class TrackSession:
                        "attitude_t": None if attitude is None else attitude.timestamp,
                        "dropped": self.source.dropped})
         self.telemetry.write(record)
-        if self.video is not None:  # labelled with the source's frame index and the recording's time
-            shown_t = record.get("t_video", record["t_run"])
-            shown = None if estimate is None else dataclasses.replace(estimate, frame_index=frame.index,
-                                                                      timestamp=shown_t)
-            rates = (command.yaw_dps, command.pitch_dps)
-            if shown is not None:
-                self.video.write(frame.image, shown, rates, [f"mode {command.mode}"])
-            else:  # the same three lines, the frame's first
-                self.video.write(frame.image, None, None, [f"#{frame.index} t={shown_t:.3f}s acquiring",
-                                                           rates_text(rates), f"mode {command.mode}"])
+        self.frames += 1
+        self.states[state] += 1
         s = self.series
         s.t.append(record["t_run"])
         s.yaw_error.append(command.yaw_error_deg)
@@ -261,6 +253,16 @@ class TrackSession:
             s.error_count += 1
             s.error_sum += error
             s.error_max = error if s.error_max is None else max(s.error_max, error)
+        if self.video is not None:  # labelled with the source's frame index and the recording's time
+            shown_t = record.get("t_video", record["t_run"])
+            shown = None if estimate is None else dataclasses.replace(estimate, frame_index=frame.index,
+                                                                      timestamp=shown_t)
+            rates = (command.yaw_dps, command.pitch_dps)
+            if shown is not None:
+                self.video.write(frame.image, shown, rates, [f"mode {command.mode}"])
+            else:  # the same three lines, the frame's first
+                self.video.write(frame.image, None, None, [f"#{frame.index} t={shown_t:.3f}s acquiring",
+                                                           rates_text(rates), f"mode {command.mode}"])
 
     # -- recording -----------------------------------------------------------------------
     def _start_recording(self) -> None:

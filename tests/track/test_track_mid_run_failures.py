@@ -3,6 +3,7 @@ session itself stops the gimbal (zero, then release) and the summary says how th
 with every frame so far in the telemetry."""
 from __future__ import annotations
 
+import errno
 import json
 from pathlib import Path
 from typing import Any
@@ -10,7 +11,7 @@ from typing import Any
 import cv2
 import pytest
 
-from pipelines.outputs.telemetry import read_telemetry
+from pipelines.outputs.telemetry import TelemetryWriter, read_telemetry
 from pipelines.track_session import TrackSession
 from tests.track.helpers import assert_stopped_at_end, decoded, drifting, make_clip, roi_at, run_track
 
@@ -66,3 +67,24 @@ def test_a_crash_mid_run_stops_the_gimbal_and_keeps_the_outputs(
     summary = _assert_stopped_by_the_session(out, "failed", 7)
     assert summary["error"] == "RuntimeError('a bug')"
     assert (out / "plot.png").exists()
+
+
+def test_a_telemetry_line_that_cannot_be_written_is_not_counted(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The disk fills up at the eighth frame's telemetry line: the summary's ``frames`` (and its
+    states) count the seven frames the telemetry holds, not the eighth, whose line is missing."""
+    real = TelemetryWriter.write
+    calls: list[int] = []
+
+    def full_at_the_eighth(self: TelemetryWriter, record: Any) -> None:
+        calls.append(1)
+        if len(calls) == 8:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(self, record)
+
+    monkeypatch.setattr(TelemetryWriter, "write", full_at_the_eighth)
+    out = tmp_path / "out"
+    assert run_track(make_clip(tmp_path / "clip.avi", FRAMES, drifting), out,
+                     "--roi", roi_at(drifting), "--no-video") == 1
+    summary = _assert_stopped_by_the_session(out, "output failed", 7)
+    assert sum(summary["states"].values()) == 7 and summary["angular_error_deg"]["frames"] <= 7
