@@ -89,14 +89,27 @@ FAST_CSRT = {"use_segmentation": False}
 
 
 def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
-    load_nanotrack_networks(model_dir)  # wrong or damaged files fail here, naming the file, not in init()
+    """OpenCV's TrackerNano, made once: it reads its model files itself (it takes paths only) and
+    its init() starts afresh, so the one tracker serves every (re)start and the files are read
+    once. A start and a search on a blank frame try both networks here: on a ``cv2.error`` the
+    files are checked (``load_nanotrack_networks``) so the ``ValueError`` names the bad one,
+    here rather than mid-run."""
     backbone, head = nanotrack_model_files(model_dir)
+    params = cv2.TrackerNano_Params()
+    params.backbone, params.neckhead = str(backbone), str(head)
+    try:
+        tracker = cv2.TrackerNano_create(params)
+        blank = np.zeros((2 * _NANO_PROBE_BOX, 2 * _NANO_PROBE_BOX, 3), np.uint8)
+        tracker.init(blank, (_NANO_PROBE_BOX // 2, _NANO_PROBE_BOX // 2, _NANO_PROBE_BOX, _NANO_PROBE_BOX))
+        tracker.update(blank)
+    except cv2.error as exc:
+        load_nanotrack_networks(model_dir)
+        reason = str(exc).strip().splitlines()[-1]
+        raise ValueError(f"OpenCV's TrackerNano cannot use {backbone} and {head}: {reason}") from exc
+    return lambda: tracker
 
-    def create() -> cv2.Tracker:
-        params = cv2.TrackerNano_Params()
-        params.backbone, params.neckhead = str(backbone), str(head)
-        return cv2.TrackerNano_create(params)
-    return create
+
+_NANO_PROBE_BOX = 32  # side of the box the model-file check starts TrackerNano on, pixels
 
 
 BACKEND_NAMES = ("dcf", "nanotrack", "csrt-fast", "csrt", "kcf", "mil", "mosse", "nano")
