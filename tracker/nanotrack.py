@@ -211,12 +211,17 @@ def crop_square(frame: np.ndarray, cx: float, cy: float, side: float, out: int,
 @dataclass(frozen=True)
 class Peak:
     """The chosen score-map point: box (cx, cy, w, h) in image pixels, its score and penalty, and
-    the search features' likeness there to the subject's template features (0..1)."""
+    where its box's centre lies on the search crop's backbone features (col, row), in cells."""
 
     box: tuple[float, float, float, float]
     score: float
     penalty: float
-    likeness: float
+    features: np.ndarray  # (C, H, W)
+    cell: tuple[float, float]
+
+    def likeness(self, subject: np.ndarray) -> float:
+        """The search features under the box against the subject's template cells (C, rows, cols), 0..1."""
+        return cosine_likeness(subject, sample_cells(self.features, self.cell, (subject.shape[2], subject.shape[1])))
 
 
 class NanoTrackBackend:
@@ -268,7 +273,7 @@ class NanoTrackBackend:
         self._center = center
         self._size = np.clip(size, MIN_SIZE, frame_size)
         (cx, cy), (w, h) = self._center, np.minimum(self._size * self._calibration, frame_size)
-        score = np.clip(peak.score, 0, 1) * self._relative_likeness(peak.likeness)
+        score = np.clip(peak.score, 0, 1) * self._relative_likeness(peak.likeness(self._subject_features))
         return from_center(float(cx), float(cy), float(w), float(h)), float(score)
 
     @property
@@ -329,7 +334,5 @@ class NanoTrackBackend:
         bcx, bcy, bw, bh = boxes[:, row, col]
         middle = (SCORE_SIZE - 1) / 2  # the search features' cell at the crop's centre
         cell = (middle + bcx / STRIDE, middle + bcy / STRIDE)
-        subject = self._subject_features
-        likeness = cosine_likeness(subject, sample_cells(features[0], cell, (subject.shape[2], subject.shape[1])))
         box = (float(center[0] + bcx / scale), float(center[1] + bcy / scale), float(bw / scale), float(bh / scale))
-        return Peak(box, float(score[row, col]), penalty, likeness)
+        return Peak(box, float(score[row, col]), penalty, features[0], cell)
