@@ -285,12 +285,13 @@ class RateController:
         e_yaw, e_pitch = wrap_deg(target[0] - gimbal[0]), target[1] - gimbal[1]
         self._yaw_unwrapped += wrap_deg(gimbal[0] - self._yaw_unwrapped)
         ff_yaw, ff_pitch = w * c.feedforward * d.yaw_rate, w * c.feedforward * d.pitch_rate
-        yaw = ff_yaw + self._pid_yaw(self._shaped(e_yaw), dt, measurement=self._yaw_unwrapped,
+        (seen_yaw, shaped_yaw), (seen_pitch, shaped_pitch) = self._shaped(e_yaw), self._shaped(e_pitch)
+        yaw = ff_yaw + self._pid_yaw(seen_yaw, dt, measurement=self._yaw_unwrapped,
                                      bounds=self._reachable(self._last.yaw_dps, dt, ff_yaw),
-                                     integrate=not self._is_shaped(e_yaw))
-        pitch = ff_pitch + self._pid_pitch(self._shaped(e_pitch), dt, measurement=gimbal[1],
+                                     integrate=not shaped_yaw)
+        pitch = ff_pitch + self._pid_pitch(seen_pitch, dt, measurement=gimbal[1],
                                            bounds=self._reachable(self._last.pitch_dps, dt, ff_pitch),
-                                           integrate=not self._is_shaped(e_pitch))
+                                           integrate=not shaped_pitch)
         return self._emit(yaw, pitch, mode, dt, estimate, now, (e_yaw, e_pitch))
 
     def _reachable(self, last: float, dt: float, offset: float) -> tuple[float, float]:
@@ -301,19 +302,15 @@ class RateController:
         speed, step = min(c.max_speed_dps, PROTOCOL_MAX_SPEED_DPS), c.max_accel_dps2 * dt
         return max(-speed, last - step) - offset, min(speed, last + step) - offset
 
-    def _is_shaped(self, error: float) -> bool:
-        """Whether ``error`` is beyond where :meth:`_shaped` leaves it unchanged."""
-        c = self.config
-        return c.kp * c.kp * abs(error) > 2.0 * c.brake_accel_dps2
-
-    def _shaped(self, error: float) -> float:
-        """The error the PID sees: unchanged while kp * |error| <= sqrt(2 * brake * |error|),
-        beyond that shrunk so the closing speed is the speed from which the gimbal can still
-        stop on the target at ``brake_accel_dps2`` (large steps close fast without overshoot)."""
-        if not self._is_shaped(error):
-            return error
+    def _shaped(self, error: float) -> tuple[float, bool]:
+        """The error the PID sees, and whether it was shrunk (the PID then does not integrate):
+        unchanged while kp * |error| <= sqrt(2 * brake * |error|), beyond that shrunk so the
+        closing speed is the speed from which the gimbal can still stop on the target at
+        ``brake_accel_dps2`` (large steps close fast without overshoot)."""
         c, e = self.config, abs(error)
-        return math.copysign(math.sqrt(2.0 * c.brake_accel_dps2 * e) / c.kp, error)
+        if not c.kp * c.kp * e > 2.0 * c.brake_accel_dps2:  # not <=: a NaN error passes unchanged
+            return error, False
+        return math.copysign(math.sqrt(2.0 * c.brake_accel_dps2 * e) / c.kp, error), True
 
     def _emit(self, yaw: float, pitch: float, mode: str, dt: float, estimate: TargetEstimate | None,
               now: float, errors: tuple[float, float] = (math.nan, math.nan), limit_accel: bool = True) -> RateCommand:
