@@ -14,6 +14,7 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from tracker import camera_motion
 from tracker.boxes import Box
 from tracker.frames import as_bgr, as_bgr_or_grey, as_grey
 from tracker.model_files import find_model_file
@@ -112,7 +113,7 @@ class HogPersonDetector:
 
 
 class MotionDetector:
-    """Moving blobs from a static camera, largest first.
+    """Moving blobs, largest first, from a still or moving camera.
 
     A moving thing is where the newest frame differs from the background, in patches where
     something moves now (the newest frame differs from both of the two before it), plus the
@@ -123,10 +124,13 @@ class MotionDetector:
     alone mark it, so a textured thing trails its last step and a flat one shows only its edges
     until the ground behind it has been seen. Foreground in which nothing moved for
     ``ADOPT_FRAMES`` frames (the ground a thing left, edges after the camera shook) becomes
-    background. A change over more than ``restart_fraction`` of the picture (the light, the camera
-    turned) or of the frame size starts afresh. The score is the blob's share of the moving area.
-    Needs three frames before it reports anything. Works on frames shrunk to ``MOTION_WORK_SIDE``
-    px; boxes are in the frame's pixels.
+    background. When the camera moved between two frames (panned, turned on a gimbal, shaken in the
+    hand; :func:`tracker.camera_motion.camera_motion`), the earlier frames and the background are
+    first carried into the new frame's pixels, and the strip at the edge that they did not see
+    says nothing. A change over more than ``restart_fraction`` of the picture (the light, a camera
+    motion that could not be told) or of the frame size starts afresh. The score is the blob's
+    share of the moving area. Needs three frames before it reports anything. Works on frames shrunk
+    to ``MOTION_WORK_SIDE`` px; boxes are in the frame's pixels.
     """
 
     def __init__(self, threshold: int = 20, min_area_fraction: float = 0.0005, settle_frames: int = 30,
@@ -138,6 +142,7 @@ class MotionDetector:
         self._settle_frames = settle_frames
         self._restart_fraction = restart_fraction
         self._history: deque[np.ndarray] = deque(maxlen=3)
+        self._seen: deque[np.ndarray | None] = deque(maxlen=3)  # per frame: the pixels of the newest it saw (None: all)
         self._background: _Background | None = None
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
@@ -146,7 +151,12 @@ class MotionDetector:
         grey = _work_grey(frame)
         if self._history and self._history[-1].shape != grey.shape:
             self._restart()
+        if self._history:
+            matrix = camera_motion.camera_motion(self._history[-1], grey)
+            if matrix is not None:
+                self._follow_camera(matrix)
         self._history.append(grey)
+        self._seen.append(None)
         if len(self._history) < 3:
             return []
         mask = self._moving_things(grey, self._moving_now(*self._history))
@@ -158,18 +168,37 @@ class MotionDetector:
 
     def _restart(self) -> None:
         self._history.clear()
+        self._seen.clear()
         self._background = None
 
+    def _follow_camera(self, matrix: np.ndarray) -> None:
+        """Carry the earlier frames, what they saw and the background by the camera's ``matrix``
+        into the next frame's pixels."""
+        shape = self._history[-1].shape
+        self._history = deque((camera_motion.warp(h, matrix) for h in self._history), maxlen=3)
+        self._seen = deque((cv2.bitwise_and(camera_motion.covered(shape, matrix),
+                                            camera_motion.warp(s, matrix, nearest=True) if s is not None else 255)
+                            for s in self._seen), maxlen=3)
+        if self._background is not None:
+            self._background.follow(matrix, self._seen[-1])
+
+    def _seen_by_all(self) -> np.ndarray | None:
+        """The pixels of the newest frame that every remembered frame saw (0 or 255; None: all)."""
+        masks = [s for s in self._seen if s is not None]
+        return functools.reduce(cv2.bitwise_and, masks) if masks else None
+
     def _moving_now(self, older: np.ndarray, previous: np.ndarray, current: np.ndarray) -> np.ndarray:
-        """Pixels where the newest frame differs from both of the two before it (0 or 255)."""
-        return cv2.bitwise_and(_differs(current, previous, self._threshold),
-                               _differs(current, older, self._threshold))
+        """Pixels where the newest frame differs from both of the two before it, where both saw it (0 or 255)."""
+        moving = cv2.bitwise_and(_differs(current, previous, self._threshold),
+                                 _differs(current, older, self._threshold))
+        seen = self._seen_by_all()
+        return moving if seen is None else cv2.bitwise_and(moving, seen)
 
     def _moving_things(self, grey: np.ndarray, moving: np.ndarray) -> np.ndarray:
         """Foreground patches holding a ``moving`` pixel, and the moving pixels the background does not
         explain (0 or 255); learns the background from ``grey`` on the way."""
         if self._background is None:
-            self._background = _Background(self._history, self._threshold, self._settle_frames)
+            self._background = _Background(self._history, self._threshold, self._settle_frames, self._seen_by_all())
         else:
             self._background.learn(grey)
         foreground = self._background.foreground(grey)
@@ -200,13 +229,18 @@ class _Background:
     moving thing are not learnt.
     """
 
-    def __init__(self, frames: Sequence[np.ndarray], threshold: int, settle_frames: int) -> None:
-        """Start from the first three ``frames``: outside the boxes of whatever changed in them, known."""
+    def __init__(self, frames: Sequence[np.ndarray], threshold: int, settle_frames: int,
+                 seen: np.ndarray | None = None) -> None:
+        """Start from the first three ``frames`` (in the last one's pixels): outside the boxes of
+        whatever changed in them, known; only where all three ``seen`` it (0 or 255, None: all)."""
         self._threshold = threshold
         self._settle_frames = settle_frames
         first, second, current = frames
         changed = cv2.bitwise_or(_differs(second, first, threshold), _differs(current, first, threshold))
-        self._known = cv2.bitwise_not(_boxes_around(changed))
+        if seen is None:
+            self._known = cv2.bitwise_not(_boxes_around(changed))
+        else:
+            self._known = cv2.bitwise_and(cv2.bitwise_not(_boxes_around(cv2.bitwise_and(changed, seen))), seen)
         self._level = current.copy()
         self._held = current.copy()  # the level each pixel holds to
         self._age = np.zeros_like(current)  # frames it has held it, up to 255
@@ -219,6 +253,14 @@ class _Background:
         settled = cv2.compare(self._age, self._settle_frames, cv2.CMP_GE)
         cv2.copyTo(grey, settled, self._level)
         cv2.bitwise_or(self._known, settled, self._known)
+
+    def follow(self, matrix: np.ndarray, seen: np.ndarray) -> None:
+        """Carry the background by the camera's ``matrix`` into the next frame's pixels; it is known
+        only where the last frame ``seen`` it (0 or 255)."""
+        self._level = camera_motion.warp(self._level, matrix)
+        self._held = camera_motion.warp(self._held, matrix)
+        self._age = camera_motion.warp(self._age, matrix, nearest=True)
+        self._known = cv2.bitwise_and(camera_motion.warp(self._known, matrix, nearest=True), seen)
 
     def adopt(self, grey: np.ndarray, still: np.ndarray) -> None:
         """Take ``grey`` as the background where ``still`` (bool) once it has held there for ``ADOPT_FRAMES``."""
