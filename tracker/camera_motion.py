@@ -10,19 +10,24 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-MAX_CORNERS = 150
+FIT_SIDE = 400  # images longer than this are halved for the fit (a third of its cost; sub-pixel anyway)
+MAX_CORNERS = 100
 MIN_INLIERS = 20  # fewer corners agreeing on one motion: the camera's motion cannot be told
 MIN_INLIER_SHARE = 0.3  # ... or fewer than this share of the corners followed
 GRID = 4  # the picture in GRID x GRID cells: the agreeing corners must lie in MIN_CELLS of them,
 MIN_CELLS = 8  # so that a thing moving over part of the picture is not taken for the camera
 STILL_PX = 0.5  # a motion that moves no corner of the image further than this: the camera stood still
-RANSAC_PX = 1.0
+RANSAC_PX = 1.0  # in the given images' pixels
 
 
 def camera_motion(older: np.ndarray, newer: np.ndarray) -> np.ndarray | None:
     """The 2 x 3 transform that carries ``older``'s pixels to where they are in ``newer`` (same size,
     ``uint8`` grey), or None when the camera stood still or its motion cannot be told (too few
     corners, or too few of them agreeing)."""
+    shape = older.shape
+    factor = 2.0 if max(shape) > FIT_SIDE else 1.0
+    if factor > 1.0:
+        older, newer = (cv2.resize(image, None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA) for image in (older, newer))
     corners = cv2.goodFeaturesToTrack(older, MAX_CORNERS, 0.01, max(4, max(older.shape) // 40), blockSize=5)
     if corners is None or len(corners) < MIN_INLIERS:
         return None
@@ -31,7 +36,7 @@ def camera_motion(older: np.ndarray, newer: np.ndarray) -> np.ndarray | None:
     if followed.sum() < MIN_INLIERS:
         return None
     matrix, inliers = cv2.estimateAffinePartial2D(corners[followed], moved[followed], method=cv2.RANSAC,
-                                                  ransacReprojThreshold=RANSAC_PX)
+                                                  ransacReprojThreshold=RANSAC_PX / factor)
     if matrix is None:
         return None
     agreeing = inliers.ravel() == 1
@@ -39,7 +44,8 @@ def camera_motion(older: np.ndarray, newer: np.ndarray) -> np.ndarray | None:
         return None
     if _cells(corners[followed][agreeing], older.shape) < MIN_CELLS:
         return None
-    return None if _largest_shift(matrix, older.shape) <= STILL_PX else matrix
+    matrix[:, 2] *= factor
+    return None if _largest_shift(matrix, shape) <= STILL_PX else matrix
 
 
 def warp(image: np.ndarray, matrix: np.ndarray, nearest: bool = False) -> np.ndarray:
