@@ -27,7 +27,7 @@ def camera_motion(older: np.ndarray, newer: np.ndarray) -> np.ndarray | None:
     shape = older.shape
     factor = 2.0 if max(shape) > FIT_SIDE else 1.0
     if factor > 1.0:
-        older, newer = (cv2.resize(image, None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA) for image in (older, newer))
+        older, newer = (cv2.resize(i, None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA) for i in (older, newer))
     corners = cv2.goodFeaturesToTrack(older, MAX_CORNERS, 0.01, max(4, max(older.shape) // 40), blockSize=5)
     if corners is None or len(corners) < MIN_INLIERS:
         return None

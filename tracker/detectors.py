@@ -174,13 +174,12 @@ class MotionDetector:
     def _follow_camera(self, matrix: np.ndarray) -> None:
         """Carry the earlier frames, what they saw and the background by the camera's ``matrix``
         into the next frame's pixels."""
-        shape = self._history[-1].shape
+        covered = camera_motion.covered(self._history[-1].shape, matrix)
         self._history = deque((camera_motion.warp(h, matrix) for h in self._history), maxlen=3)
-        self._seen = deque((cv2.bitwise_and(camera_motion.covered(shape, matrix),
-                                            camera_motion.warp(s, matrix, nearest=True) if s is not None else 255)
+        self._seen = deque((covered if s is None else cv2.bitwise_and(covered, camera_motion.warp(s, matrix, True))
                             for s in self._seen), maxlen=3)
         if self._background is not None:
-            self._background.follow(matrix, self._seen[-1])
+            self._background.follow(matrix, covered)
 
     def _seen_by_all(self) -> np.ndarray | None:
         """The pixels of the newest frame that every remembered frame saw (0 or 255; None: all)."""
@@ -255,11 +254,11 @@ class _Background:
         cv2.bitwise_or(self._known, settled, self._known)
 
     def follow(self, matrix: np.ndarray, seen: np.ndarray) -> None:
-        """Carry the background by the camera's ``matrix`` into the next frame's pixels; it is known
-        only where the last frame ``seen`` it (0 or 255)."""
+        """Carry the background by the camera's ``matrix`` into the next frame's pixels; it is known,
+        and a level held, only where the last frame ``seen`` it (0 or 255)."""
         self._level = camera_motion.warp(self._level, matrix)
         self._held = camera_motion.warp(self._held, matrix)
-        self._age = camera_motion.warp(self._age, matrix, nearest=True)
+        self._age = cv2.bitwise_and(camera_motion.warp(self._age, matrix, nearest=True), seen)
         self._known = cv2.bitwise_and(camera_motion.warp(self._known, matrix, nearest=True), seen)
 
     def adopt(self, grey: np.ndarray, still: np.ndarray) -> None:
