@@ -172,12 +172,12 @@ class MotionDetector:
         self._background = None
 
     def _follow_camera(self, matrix: np.ndarray) -> None:
-        """Carry the earlier frames, what they saw and the background by the camera's ``matrix``
-        into the next frame's pixels."""
+        """Carry the two latest frames (the next one pushes the third out), what they saw and the
+        background by the camera's ``matrix`` into the next frame's pixels."""
         covered = camera_motion.covered(self._history[-1].shape, matrix)
-        self._history = deque((camera_motion.warp(h, matrix) for h in self._history), maxlen=3)
+        self._history = deque((camera_motion.warp(h, matrix) for h in list(self._history)[-2:]), maxlen=3)
         self._seen = deque((covered if s is None else cv2.bitwise_and(covered, camera_motion.warp(s, matrix, True))
-                            for s in self._seen), maxlen=3)
+                            for s in list(self._seen)[-2:]), maxlen=3)
         if self._background is not None:
             self._background.follow(matrix, covered)
 
