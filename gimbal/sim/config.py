@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from gimbal.messages.telemetry import DEVICE_ID_R_SDK
+from gimbal.messages.telemetry import DEVICE_ID_R_SDK, DEVICE_ID_RANGE
+from gimbal.sim.checks import check, integer, number
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 
 
@@ -34,12 +35,29 @@ class SimConfig:
     camera_connected: bool = True  # False: camera commands fail with 0x02
 
     def __post_init__(self) -> None:
-        for name in ("push_rate_hz", "tick_hz", "max_speed_dps", "accel_dps2", "speed_timeout_s",
-                     "recenter_speed_dps", "joystick_full_scale_dps", "calibration_push_hz",
-                     "focus_speed"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"SimConfig.{name} must be positive, not {getattr(self, name)}")
-        if any(s not in (-1, 1) for s in self.speed_signs) or len(self.speed_signs) != 3:
-            raise ValueError(f"SimConfig.speed_signs must be three of ±1, not {self.speed_signs}")
-        if not 0 <= self.version <= 0xFFFFFFFF:
-            raise ValueError(f"SimConfig.version 0x{self.version:X} does not fit 32 bits")
+        check(self, RULES)
+
+
+_RATE, _SPEED, _TIME = "a finite rate above 0 Hz", "a finite speed above 0 °/s", "a finite time, 0 s or more"
+_CAN_ID = ("a standard CAN id, 0 to 0x7FF", integer(0, 0x7FF))
+#: field: (what it takes, test); NaN and infinities fail every test.
+RULES = {
+    "rx_id": _CAN_ID, "tx_id": _CAN_ID,
+    "push_rate_hz": (_RATE, number(0, above=True)),
+    "tick_hz": (_RATE, number(0, above=True)),
+    "max_speed_dps": (_SPEED, number(0, above=True)),
+    "accel_dps2": ("a finite acceleration above 0", number(0, above=True)),
+    "speed_timeout_s": ("a finite time above 0 s", number(0, above=True)),
+    "base_yaw_deg": ("a finite angle", number()),
+    "recenter_speed_dps": (_SPEED, number(0, above=True)),
+    "joystick_full_scale_dps": (_SPEED, number(0, above=True)),
+    "speed_signs": ("three of ±1", lambda v: isinstance(v, tuple) and len(v) == 3 and all(s in (-1, 1) for s in v)),
+    "initial_joint_deg": ("three finite angles", lambda v: isinstance(v, tuple) and len(v) == 3
+                          and all(map(number(), v))),
+    "device_id": ("a device id, 1 to 0xFFFFFFFF (0 is reserved)", integer(*DEVICE_ID_RANGE)),
+    "version": ("a 32-bit version, 0 to 0xFFFFFFFF", integer(0, 0xFFFFFFFF)),
+    "calibration_s": (_TIME, number(0)),
+    "calibration_push_hz": (_RATE, number(0, above=True)),
+    "focus_speed": ("a finite speed above 0 units/s", number(0, above=True)),
+    "focus_calibration_s": (_TIME, number(0)),
+}

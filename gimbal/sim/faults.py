@@ -4,9 +4,12 @@ does not depend on how many pushes or foreign frames the other thread drew befor
 seed and the same commands give the same faults."""
 from __future__ import annotations
 
+import math
 import random
 from collections import Counter
 from dataclasses import dataclass
+
+from gimbal.sim.checks import check, integer, number
 
 DIRECTIONS = ("both", "rx", "tx")
 FOREIGN_IDS = (0x530, 0x531, 0x426)  # DJI's internal accessory traffic seen on live buses
@@ -31,20 +34,29 @@ class Faults:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("drop", "corrupt", "nack", "legacy"):
-            value = getattr(self, name)
-            if not 0.0 <= value <= 1.0:
-                raise ValueError(f"Faults.{name} is a fraction in 0..1, not {value}")
-        if self.direction not in DIRECTIONS:
-            raise ValueError(f"Faults.direction must be one of {', '.join(DIRECTIONS)}, not {self.direction!r}")
-        if self.delay_s < 0:
-            raise ValueError("Faults.delay_s cannot be negative")
-        if not 0 <= self.foreign_rate <= MAX_FOREIGN_RATE_HZ:
-            raise ValueError(f"Faults.foreign_rate is 0 to {MAX_FOREIGN_RATE_HZ} frames/s, not {self.foreign_rate}")
-        if not 0 <= self.nack_code <= 0xFF:
-            raise ValueError(f"Faults.nack_code {self.nack_code} does not fit a byte")
-        if self.silent is not None and not 0 <= self.silent[0] <= self.silent[1]:
-            raise ValueError(f"Faults.silent {self.silent} must be (start, end) with 0 <= start <= end")
+        check(self, RULES)
+
+
+def _window(value: object) -> bool:
+    """None, or (start, end) seconds with 0 <= start <= end; start finite, end may be inf (for ever)."""
+    return value is None or (isinstance(value, tuple) and len(value) == 2 and number(0)(value[0])
+                             and (value[1] == math.inf or number(value[0])(value[1])))
+
+
+_FRACTION = ("a fraction from 0 to 1", number(0, 1))
+#: field: (what it takes, test); NaN fails every test. ``delay_s``'s words leave the unit out (the
+#: CLI takes milliseconds).
+RULES = {
+    "drop": _FRACTION, "corrupt": _FRACTION,
+    "direction": (f"one of {', '.join(DIRECTIONS)}", lambda v: v in DIRECTIONS),
+    "delay_s": ("a finite delay, 0 or more", number(0)),
+    "nack": _FRACTION,
+    "nack_code": ("a byte, 0 to 0xFF", integer(0, 0xFF)),
+    "silent": ("a window START:END in seconds, 0 <= START <= END (END may be inf)", _window),
+    "legacy": _FRACTION,
+    "foreign_rate": (f"a rate from 0 to {MAX_FOREIGN_RATE_HZ} Hz (a 1 Mbit/s bus carries less)",
+                     number(0, MAX_FOREIGN_RATE_HZ)),
+}
 
 
 class FaultInjector:

@@ -8,14 +8,14 @@ import math
 import signal
 import threading
 import time
-from collections.abc import Callable
 from types import FrameType
 
 import can
 
 from gimbal.messages.motion import AXES
 from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
-from gimbal.sim.faults import DIRECTIONS, MAX_FOREIGN_RATE_HZ
+from gimbal.sim.checks import FieldError
+from gimbal.sim.faults import DIRECTIONS
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
 
@@ -80,8 +80,8 @@ def _version(text: str) -> int:
             values = [int(p, 16) for p in parts]
             if all(0 <= v <= 0xFF for v in values):
                 return int.from_bytes(bytes(values), "big")
-        elif len(parts) == 1 and 0 <= (value := int(text, 0)) <= 0xFFFFFFFF:
-            return value
+        elif len(parts) == 1:  # SimConfig checks that it fits 32 bits
+            return int(text, 0)
     except ValueError:
         pass
     raise argparse.ArgumentTypeError(f"not a version AA.BB.CC.DD or 32-bit integer: {text!r}")
@@ -100,39 +100,24 @@ def _window(text: str) -> tuple[float, float]:
         window = (float(start), float(end))
     except ValueError:
         window = None
-    if not sep or window is None or not 0 <= window[0] <= window[1]:
-        raise argparse.ArgumentTypeError(f"not a window START:END in seconds with START <= END: {text!r}")
+    if not sep or window is None:  # Faults checks the numbers
+        raise argparse.ArgumentTypeError(f"not a window START:END in seconds: {text!r}")
     return window
 
 
-def _in_range(low: float, high: float, low_included: bool = True) -> Callable[[float], bool]:
-    """A test for finite numbers from ``low`` (or above it) to ``high``."""
-    return lambda v: math.isfinite(v) and (low <= v if low_included else low < v) and v <= high
-
-
-#: (option, attribute, what it takes, test): NaN fails every test.
-NUMBER_RULES: tuple[tuple[str, str, str, Callable[[float], bool]], ...] = (
-    ("--push-rate", "push_rate", "a finite rate above 0 Hz", _in_range(0, math.inf, False)),
-    ("--accel", "accel", "a finite acceleration above 0", _in_range(0, math.inf, False)),
-    ("--base-yaw", "base_yaw", "a finite angle", math.isfinite),
-    ("--calibration-time", "calibration_time", "a finite time, 0 s or more", _in_range(0, math.inf)),
-    ("--drop", "drop", "a fraction from 0 to 1", _in_range(0, 1)),
-    ("--corrupt", "corrupt", "a fraction from 0 to 1", _in_range(0, 1)),
-    ("--delay-ms", "delay_ms", "a finite delay, 0 ms or more", _in_range(0, math.inf)),
-    ("--nack", "nack", "a fraction from 0 to 1", _in_range(0, 1)),
-    ("--nack-code", "nack_code", "a byte, 0 to 0xFF", _in_range(0, 0xFF)),
-    ("--legacy-fraction", "legacy_fraction", "a fraction from 0 to 1", _in_range(0, 1)),
-    ("--foreign-rate", "foreign_rate", f"a rate from 0 to {MAX_FOREIGN_RATE_HZ} Hz (a 1 Mbit/s bus carries less)",
-     _in_range(0, MAX_FOREIGN_RATE_HZ)),
-    ("--status-interval", "status_interval", "a finite interval, 0 s or more", _in_range(0, math.inf)),
-)
+#: The library's fields (``SimConfig``/``Faults`` check every value) by the options that set them.
+OPTION_OF_FIELD = {
+    "SimConfig.push_rate_hz": "--push-rate", "SimConfig.accel_dps2": "--accel",
+    "SimConfig.base_yaw_deg": "--base-yaw", "SimConfig.version": "--version",
+    "SimConfig.calibration_s": "--calibration-time",
+    "Faults.drop": "--drop", "Faults.corrupt": "--corrupt", "Faults.delay_s": "--delay-ms",
+    "Faults.nack": "--nack", "Faults.nack_code": "--nack-code", "Faults.silent": "--silent",
+    "Faults.legacy": "--legacy-fraction", "Faults.foreign_rate": "--foreign-rate",
+}
 
 
 def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
     """The simulator's configuration and faults from the parsed options; ``CliError`` if invalid."""
-    for option, name, what, accepts in NUMBER_RULES:  # in the options' words, and NaN too
-        if not accepts(getattr(args, name)):
-            raise CliError(f"{option} takes {what}, not {getattr(args, name):g}")
     try:
         config = SimConfig(rx_id=args.tx_id, tx_id=args.rx_id, legacy=args.legacy,
                            push_rate_hz=args.push_rate, accel_dps2=args.accel, base_yaw_deg=args.base_yaw,
@@ -143,13 +128,26 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
                         delay_s=args.delay_ms / 1000.0, nack=args.nack, nack_code=args.nack_code,
                         silent=args.silent, legacy=args.legacy_fraction, foreign_rate=args.foreign_rate,
                         seed=args.seed)
-    except ValueError as exc:
-        raise CliError(str(exc)) from None
+    except FieldError as exc:
+        option = OPTION_OF_FIELD.get(exc.name)
+        if option is None:  # a field no option sets (the ids are checked as they are parsed)
+            raise CliError(str(exc)) from None
+        given = getattr(args, option[2:].replace("-", "_"))  # in the option's unit (--delay-ms)
+        raise CliError(f"{option} takes {exc.takes}, not {_given(given)}") from None
+    if not 0 <= args.status_interval < math.inf:  # the CLI's own: NaN fails too
+        raise CliError(f"--status-interval takes a finite interval, 0 s or more, not {args.status_interval:g}")
     if args.duration is not None and args.duration <= 0:
         raise CliError(f"--duration must be positive, not {args.duration}")
     if args.tx_id == args.rx_id:
         raise CliError(f"--tx-id and --rx-id must differ (both 0x{args.tx_id:03X})")
     return config, faults
+
+
+def _given(value: float | tuple[float, float]) -> str:
+    """An option's value as the user wrote it, near enough: 1e+300, nan, 999, 3:1."""
+    if isinstance(value, tuple):
+        return ":".join(f"{v:g}" for v in value)
+    return str(value) if isinstance(value, int) else f"{value:g}"
 
 
 def open_bus(args: argparse.Namespace) -> can.BusABC:

@@ -122,7 +122,9 @@ FOREIGN_RATE = "--foreign-rate takes a rate from 0 to 20000 Hz (a 1 Mbit/s bus c
     (["--drop", "1.5"], "--drop takes a fraction from 0 to 1, not 1.5"),
     (["--push-rate", "0"], "--push-rate takes a finite rate above 0 Hz, not 0"),
     # NaN once passed every check and stopped the simulator's threads; the words were SimConfig's
-    (["--delay-ms", "nan"], "--delay-ms takes a finite delay, 0 ms or more, not nan"),
+    (["--delay-ms", "nan"], "--delay-ms takes a finite delay, 0 or more, not nan"),
+    (["--delay-ms=-5"], "--delay-ms takes a finite delay, 0 or more, not -5"),  # the option's unit, not Faults'
+    (["--accel", "inf"], "--accel takes a finite acceleration above 0, not inf"),
     (["--base-yaw", "nan"], "--base-yaw takes a finite angle, not nan"),
     (["--foreign-rate", "nan"], f"{FOREIGN_RATE}, not nan"),
     (["--foreign-rate", "1e300"], f"{FOREIGN_RATE}, not 1e+300"),  # once let through: that many frames a tick
@@ -130,6 +132,10 @@ FOREIGN_RATE = "--foreign-rate takes a rate from 0 to 20000 Hz (a 1 Mbit/s bus c
     (["--calibration-time", "-1"], "--calibration-time takes a finite time, 0 s or more, not -1"),
     (["--status-interval", "nan"], "--status-interval takes a finite interval, 0 s or more, not nan"),
     (["--nack-code", "999"], "--nack-code takes a byte, 0 to 0xFF, not 999"),
+    # the range checks are SimConfig's and Faults', in the options' words
+    (["--silent", "3:1"], "--silent takes a window START:END in seconds, 0 <= START <= END (END may be inf), not 3:1"),
+    (["--silent", "inf:inf", "--duration", "0.2"], "--silent takes a window START:END"),
+    (["--version", "0x100000000"], "--version takes a 32-bit version, 0 to 0xFFFFFFFF, not 4294967296"),
     (["--duration", "0"], "--duration must be positive"),
     (["--tx-id", "0x222"], "must differ"),
     (["-i", "sim"], "in-process simulator"),
@@ -141,7 +147,7 @@ def test_bad_input_is_a_one_line_error(capsys, args: list[str], message: str) ->
     assert message in err and len(err.splitlines()) == 1
 
 
-@pytest.mark.parametrize("args", [["--silent", "3:1"], ["--version", "1.2.3"], ["--fault-direction", "up"],
+@pytest.mark.parametrize("args", [["--silent", "3"], ["--version", "1.2.3"], ["--fault-direction", "up"],
                                   ["--duration", "-1"], ["--duration", "nan"]])  # nan once ran for ever
 def test_malformed_options_are_usage_errors(capsys, args: list[str]) -> None:
     with pytest.raises(SystemExit) as exc:

@@ -1,0 +1,40 @@
+"""``SimConfig`` and ``Faults`` refuse every non-finite or out-of-range value with a ValueError
+naming the field: a NaN delay once queued every reply for ever, a NaN base yaw killed the tick
+thread at the first parameter push, while the process carried on."""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from gimbal.sim import Faults, SimConfig
+from gimbal.sim.checks import FieldError
+
+NAN, INF = math.nan, math.inf
+
+
+@pytest.mark.parametrize("field, value", [
+    ("base_yaw_deg", NAN), ("base_yaw_deg", INF), ("push_rate_hz", INF), ("accel_dps2", NAN),
+    ("max_speed_dps", INF), ("speed_timeout_s", INF), ("calibration_s", NAN), ("calibration_s", -1.0),
+    ("focus_calibration_s", INF), ("initial_joint_deg", (0.0, NAN, 0.0)), ("initial_joint_deg", (0.0, 0.0)),
+    ("rx_id", 0x800), ("tx_id", -1), ("device_id", 0), ("version", 1 << 32), ("speed_signs", (1, 0, 1)),
+])
+def test_sim_config_refuses(field: str, value: object) -> None:
+    with pytest.raises(FieldError, match=rf"^SimConfig\.{field} takes .*, not ") as caught:
+        SimConfig(**{field: value})
+    assert caught.value.name == f"SimConfig.{field}"
+
+
+@pytest.mark.parametrize("field, value", [
+    ("delay_s", NAN), ("delay_s", INF), ("delay_s", -0.001), ("drop", NAN), ("nack", 1.5),
+    ("legacy", -0.1), ("foreign_rate", NAN), ("nack_code", 0x100), ("direction", "up"),
+    ("silent", (NAN, 1.0)), ("silent", (1.0, NAN)), ("silent", (INF, INF)), ("silent", (3.0, 1.0)),
+])
+def test_faults_refuse(field: str, value: object) -> None:
+    with pytest.raises(ValueError, match=rf"^Faults\.{field} takes .*, not "):
+        Faults(**{field: value})
+
+
+def test_the_edges_are_taken() -> None:
+    SimConfig(calibration_s=0.0, base_yaw_deg=-720.0, rx_id=0x7FF, tx_id=0, version=0xFFFFFFFF)
+    Faults(drop=1.0, delay_s=0.0, nack_code=0xFF, foreign_rate=20_000, silent=(5.0, INF))  # silent to the end
