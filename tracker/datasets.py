@@ -89,6 +89,8 @@ def load_sequence(path: str | Path, groundtruth: str | Path | None = None) -> Se
     ``groundtruth.txt`` found in the folder (beside a video: those names, ``<stem>.txt`` or
     ``<stem>_groundtruth.txt``).
     """
+    if isinstance(path, str) and not path.strip():  # Path("") would be the current folder
+        raise FileNotFoundError("an empty sequence path (use . for the current folder)")
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"no such sequence: {path}")

@@ -31,7 +31,10 @@ def make_out_dir(out: Path) -> None:
 
 
 def existing_dir(text: str) -> Path:
-    """An existing folder (``--model-dir``): a typo must not quietly mean "no models"."""
+    """An existing folder (``--model-dir``): a typo must not quietly mean "no models", nor an empty
+    path the current folder."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path (use . for the current folder)")
     path = Path(text)
     if not path.is_dir():
         raise argparse.ArgumentTypeError(f"no such folder: {text!r}")

@@ -105,11 +105,18 @@ def _next_frame(iterator: Iterator[can.Message], path: str, frames: int) -> can.
         raise CliError(f"{path}: unreadable {where}: {_reason(exc)}") from exc
 
 
-def _open_log(path: str) -> Iterable[can.Message]:
-    if not os.path.exists(path):  # checked first: python-can judges the suffix before opening
+def check_log_path(path: str) -> None:
+    """``CliError`` unless ``path`` names a file (python-can would judge its suffix first)."""
+    if not path.strip():
+        raise CliError("an empty path: give a CAN log")
+    if not os.path.exists(path):
         raise CliError(f"{path}: no such file")
     if os.path.isdir(path):
         raise CliError(f"{path}: is a directory, not a CAN log")
+
+
+def _open_log(path: str) -> Iterable[can.Message]:
+    check_log_path(path)
     try:
         return can.LogReader(path)
     except Exception as exc:  # unknown suffix (ValueError), bad header (BLFParseError, struct.error), ...

@@ -12,7 +12,6 @@ from collections import Counter
 from collections.abc import Iterator
 from contextlib import closing, contextmanager
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, TextIO
 
 import can
@@ -24,7 +23,7 @@ from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
 from gimbal.transport import CanTransport, packet_frames
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
-from pipelines.cli.decode_cmd import _close, _open_log, iter_log_frames
+from pipelines.cli.decode_cmd import _close, _open_log, check_log_path, iter_log_frames
 from pipelines.cli.sim_cmd import status_line
 
 ARROWS = {HOST_TO_GIMBAL: "host->gimbal", None: "?"}
@@ -218,8 +217,7 @@ def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
         raise CliError(f"--speed takes a finite factor above 0, not {args.speed:g}")
     if args.interface is None and (args.channel is not None or args.bitrate is not None):
         raise CliError("-c/--channel and -b/--bitrate need -i/--interface: replay sends onto a bus only with -i")
-    if not Path(args.log).exists():  # python-can would complain about the suffix first
-        raise CliError(f"{args.log}: no such file")
+    check_log_path(args.log)  # before a bus is opened
     summary = ReplaySummary()
     with _target(args) as (bus, sim):
         started = time.monotonic()

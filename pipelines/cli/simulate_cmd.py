@@ -32,7 +32,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "  gimbaltrack simulate ../shared/data/sequences/vot15_ball1 --tracker oracle --latency 100 --out /tmp/sim\n"
         "  gimbaltrack simulate samples/demo.mp4 --controller p --json",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("sequence", metavar="SEQ_DIR", type=Path, help="sequence folder or video with ground truth")
+    parser.add_argument("sequence", metavar="SEQ_DIR", help="sequence folder or video with ground truth")
     parser.add_argument("--fov", type=float, metavar="DEG",
                         help="horizontal field of view of the view (default: crop-equivalent, the "
                         "recording's focal length)")

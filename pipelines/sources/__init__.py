@@ -28,6 +28,9 @@ def open_source(spec: str, realtime: bool = False, *, fps: float | None = None,
     and ``clock``: their timestamps are ``time.monotonic()`` at grab, and a live source that delivers
     nothing for ``stall_timeout`` s raises ``SourceError("stream stalled ...")``.
     """
+    if not spec.strip():  # Path("") is the current folder: nobody means that by an empty argument
+        raise SourceError("an empty source: give a video file, image folder (. for the current one), "
+                          "camera index or stream URL")
     if spec.isascii() and spec.isdigit():
         return open_camera(int(spec), stall_timeout, open_timeout)
     if _URL.match(spec):
