@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
+import io
 import logging
 import os
 import signal
@@ -64,6 +66,8 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     back to once the handlers are in place, when the caller holds the signals already."""
     prog, debug = "gimbaltrack", False
     quiet_opencv(sys.argv[1:] if argv is None else argv)
+    if sys.stdout is None:  # fd 1 closed (>&-): Python gives no stdout, and print() drops the results
+        sys.stdout = ClosedStdout()
     try:
         with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
             try:
@@ -82,6 +86,9 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
                     sys.stdout.flush()  # a failure to write the results shows here, not at exit
                 except BrokenPipeError:  # the reader left: the run's own status still stands (130, ...)
                     _drop_stdout()
+                except OSError as exc:  # a full disk, a closed stdout: said, and a run that was stopped
+                    failed = _unwritten(prog, exc, debug)  # or failed keeps its status (130, ...)
+                    return status or failed
                 return status
             except CliError as exc:
                 if args.debug:
@@ -98,14 +105,53 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
         _drop_stdout()
         return 0
     except OSError as exc:  # one no subcommand words itself, e.g. stdout on a full disk (> /dev/full)
-        if debug:
-            raise
-        print(f"{prog}: error: {str(exc) or type(exc).__name__}", file=sys.stderr)  # TimeoutError() says nothing
-        try:
-            sys.stdout.flush()
-        except OSError:
-            _drop_stdout()
-        return 1
+        return _unwritten(prog, exc, debug)
+
+
+def _unwritten(prog: str, exc: OSError, debug: bool) -> int:
+    """Exit status 1 after a one-line error for ``exc`` (re-raised with ``--debug``); stdout,
+    which may be what failed, is emptied so that the flush at exit cannot fail again."""
+    if debug:
+        raise exc
+    print(f"{prog}: error: {str(exc) or type(exc).__name__}", file=sys.stderr)  # TimeoutError() says nothing
+    try:
+        sys.stdout.flush()
+    except OSError:
+        _drop_stdout()
+    return 1
+
+
+STDOUT_FD = 1
+
+
+class ClosedStdout(io.TextIOBase):
+    """``sys.stdout`` when fd 1 was closed (``>&-``). It holds fd 1 open on /dev/null, so that no
+    output file opened later takes that number, and flushing what was written raises EBADF: a
+    closed stdout is reported like a full disk's (one line, exit 1), and a run's files are kept."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        null = os.open(os.devnull, os.O_WRONLY)
+        if null != STDOUT_FD:
+            os.dup2(null, STDOUT_FD)
+            os.close(null)
+        self._written = False
+
+    def writable(self) -> bool:
+        return True
+
+    def fileno(self) -> int:
+        return STDOUT_FD
+
+    def write(self, text: str) -> int:
+        self._written = self._written or bool(text)
+        return len(text)
+
+    def flush(self) -> None:
+        if self._written:  # said once: the flush at exit finds nothing more
+            self._written = False
+            raise OSError(errno.EBADF, "stdout is closed: the results went nowhere")
+
 
 
 def _drop_stdout() -> None:

@@ -3,6 +3,7 @@ that went away (a broken pipe) leaves the run's own exit status."""
 from __future__ import annotations
 
 import io
+import json
 import os
 import subprocess
 import sys
@@ -51,3 +52,52 @@ def test_an_oserror_without_words_is_named(monkeypatch: pytest.MonkeyPatch, caps
     monkeypatch.setattr(pipelines.cli.decode_cmd, "run", run)
     assert main(["decode", "--hex", "AA"]) == 1
     assert capsys.readouterr().err == "gimbaltrack decode: error: TimeoutError\n"
+
+
+def _closed_stdout(command: list[str]) -> list[str]:
+    """``command`` run with its stdout closed, as ``>&-`` does in a shell."""
+    return ["sh", "-c", '"$@" >&-', "sh", *command]
+
+
+CLOSED = ": error: [Errno 9] stdout is closed: the results went nowhere\n"
+
+
+def test_a_closed_stdout_is_one_line_and_exit_1() -> None:
+    """Python leaves ``sys.stdout`` None when fd 1 is closed: the results were once dropped by
+    print() and the final flush was an AttributeError traceback."""
+    done = subprocess.run(_closed_stdout(cli_command("decode", "--hex", "AA")), stderr=subprocess.PIPE,
+                          text=True, env=subprocess_env(), timeout=60)
+    assert (done.returncode, done.stderr) == (1, f"gimbaltrack decode{CLOSED}")
+
+
+def test_track_with_a_closed_stdout_keeps_its_outputs(tmp_path: Path) -> None:
+    command = cli_command("track", "samples/demo.mp4", "--roi", "138,152,64,96", "--no-video", "--quiet",
+                          "--max-frames", "5", "--out", str(tmp_path))
+    done = subprocess.run(_closed_stdout(command), stderr=subprocess.PIPE, text=True, env=subprocess_env(),
+                          timeout=120)
+    assert (done.returncode, done.stderr) == (1, f"gimbaltrack track{CLOSED}")
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["frames"] == 5 and summary["speed_commands"]["stop_release_sent"]
+    assert len((tmp_path / "telemetry.jsonl").read_text().splitlines()) == 5  # and nothing else landed on fd 1
+
+
+@pytest.mark.parametrize("error", [OSError(28, "No space left on device"), OSError(9, "Bad file descriptor")])
+def test_results_that_cannot_be_written_leave_a_stopped_runs_status(
+        error: OSError, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """Ctrl-C's 130 (SIGTERM's 143, ...) stands when the report then cannot be written; it was 1."""
+    class Unwritable(io.StringIO):
+        def fileno(self) -> int:  # where stdout is pointed once it has failed
+            return target.fileno()
+
+        def flush(self) -> None:
+            raise error
+
+    def run(args: object) -> int:
+        print("interrupted (SIGINT): the report")
+        return 130
+
+    monkeypatch.setattr(pipelines.cli.decode_cmd, "run", run)
+    with open(tmp_path / "stdout", "w") as target:
+        monkeypatch.setattr(sys, "stdout", Unwritable())
+        assert main(["decode", "--hex", "AA"]) == 130
+    assert capsys.readouterr().err == f"gimbaltrack decode: error: {error}\n"
