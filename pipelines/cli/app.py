@@ -64,8 +64,9 @@ def quiet_opencv(argv: list[str]) -> None:
 def main(argv: list[str] | None = None, release: Iterable[int] | None = None) -> int:
     """Parse ``argv`` and run the subcommand; its exit status. ``release``: the signal mask to go
     back to once the handlers are in place, when the caller holds the signals already."""
-    prog, debug = "gimbaltrack", False
-    quiet_opencv(sys.argv[1:] if argv is None else argv)
+    given = sys.argv[1:] if argv is None else argv
+    prog, debug = "gimbaltrack", "--debug" in given  # until parsed: an OSError may come first
+    quiet_opencv(given)
     if sys.stdout is None:  # fd 1 closed (>&-): Python gives no stdout, and print() drops the results
         sys.stdout = ClosedStdout()
     try:
