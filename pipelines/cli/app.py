@@ -154,7 +154,6 @@ class ClosedStdout(io.TextIOBase):
             raise OSError(errno.EBADF, "stdout is closed: the results went nowhere")
 
 
-
 def _drop_stdout() -> None:
     """Point stdout at /dev/null, so that Python's own flush at exit cannot fail a second time."""
     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
