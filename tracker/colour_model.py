@@ -27,19 +27,21 @@ class ColourModel:
     def __init__(self) -> None:
         self._foreground: np.ndarray | None = None
         self._background: np.ndarray | None = None
+        self._table: np.ndarray | None = None  # P(subject | bin), made on first use after a lesson
 
     def learn(self, bins: np.ndarray, foreground: np.ndarray, background: np.ndarray, rate: float) -> None:
         """Fold in the pixels of ``bins`` under the boolean masks (``rate`` 1 restarts)."""
         self._foreground = _fold(self._foreground, bins[foreground], rate)
         self._background = _fold(self._background, bins[background], rate)
+        self._table = None
 
     def likelihood(self, bins: np.ndarray) -> np.ndarray:
         """Per pixel, P(subject | colour) in 0..1 (0 for colours never seen)."""
         if self._foreground is None:
             raise RuntimeError("ColourModel.likelihood() before learn()")
-        fg = self._foreground[bins]
-        bg = self._background[bins]
-        return fg / (fg + bg + 1e-6)
+        if self._table is None:  # once per lesson for all bins: cheaper than per pixel
+            self._table = self._foreground / (self._foreground + self._background + 1e-6)
+        return self._table.take(bins)
 
 
 def _fold(histogram: np.ndarray | None, pixels: np.ndarray, rate: float) -> np.ndarray:

@@ -104,6 +104,21 @@ def test_colour_model_learns_at_its_rate():
     assert model.likelihood(colour_index(patch))[12, 12] == pytest.approx(0.375 / 1.375, rel=1e-4)
 
 
+def test_colour_likelihood_follows_every_lesson():
+    """Asked between lessons, the likelihood is that of the latest histograms (a restart included),
+    not of the ones it was first asked about."""
+    patch = np.zeros((20, 20, 3), np.uint8)
+    patch[..., 0] = 200  # blue background
+    patch[5:15, 5:15] = (0, 0, 220)  # a red subject
+    subject = np.zeros((20, 20), bool)
+    subject[5:15, 5:15] = True
+    model = ColourModel()
+    model.learn(colour_index(patch), subject, ~subject, rate=1.0)
+    assert model.likelihood(colour_index(patch))[10, 10] > 0.9
+    model.learn(colour_index(patch), ~subject, subject, rate=1.0)  # now the blue is the subject
+    assert model.likelihood(colour_index(patch))[10, 10] < 0.1
+
+
 def test_backend_follows_a_moving_target():
     seq = render_sequence(frames=40, speed=3.0, seed=3)
     backend = DcfBackend()
