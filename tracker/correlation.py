@@ -66,16 +66,20 @@ class ScaleFilter:
         self._numerator: np.ndarray | None = None
         self._denominator: np.ndarray | None = None
 
-    def learn(self, samples: np.ndarray, rate: float) -> None:
-        """Fold samples taken around the current scale into the filter (``rate`` 1 restarts)."""
-        spectrum = fft.rfft(samples * self._window, axis=0)
+    def spectrum(self, samples: np.ndarray) -> np.ndarray:
+        """The windowed samples' spectrum over the scales, which ``learn`` and ``respond`` take
+        (computed once where both use the same samples)."""
+        return fft.rfft(samples * self._window, axis=0)
+
+    def learn(self, spectrum: np.ndarray, rate: float) -> None:
+        """Fold the spectrum of samples taken around the current scale into the filter (``rate`` 1
+        restarts)."""
         self._numerator = running_average(self._numerator, self._label * np.conj(spectrum), rate)
         self._denominator = running_average(self._denominator, np.sum(np.abs(spectrum) ** 2, axis=1), rate)
 
-    def respond(self, samples: np.ndarray) -> np.ndarray:
-        """The response per scale sample, zero change at index 0 (wrapped like the label)."""
+    def respond(self, spectrum: np.ndarray) -> np.ndarray:
+        """The response per scale sample of a spectrum, zero change at index 0 (wrapped like the label)."""
         if self._numerator is None:
             raise RuntimeError("ScaleFilter.respond() before learn()")
-        spectrum = fft.rfft(samples * self._window, axis=0)
         product = np.sum(self._numerator * spectrum, axis=1) / (self._denominator + self._regularisation)
         return fft.irfft(product, n=self._scales)

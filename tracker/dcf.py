@@ -127,16 +127,18 @@ class DcfBackend:
         s = self.settings
         region = self._region(frame)
         samples = self._scale_samples(region)
-        step = self._scale_estimator.best_step(samples)
+        spectrum = self._scale_estimator.spectrum(samples)
+        step = self._scale_estimator.best_step(spectrum)
         if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
             step = 0
         self._scale *= s.scale_step**step
         if score >= s.learn_above:
             if step != 0:
                 region = self._region(frame)  # the window follows the new scale
-            self._learn(region, scale_samples=np.roll(samples, -step, axis=0))  # re-centred on it
+                spectrum = self._scale_estimator.spectrum(np.roll(samples, -step, axis=0))  # re-centred on it
+            self._learn(region, scale_spectrum=spectrum)
 
-    def _learn(self, region: _Region, restart: bool = False, scale_samples: np.ndarray | None = None) -> None:
+    def _learn(self, region: _Region, restart: bool = False, scale_spectrum: np.ndarray | None = None) -> None:
         """Teach the three models the subject in ``region``: afresh, or at the per-frame rates
         times ``update_every`` (the frames in between teach nothing)."""
         s = self.settings
@@ -146,9 +148,9 @@ class DcfBackend:
         if s.colour_weight > 0:
             fg, bg = self._masks
             self._colour.learn(colour_index(patch), fg, bg, 1.0 if restart else k * s.colour_rate)
-        if scale_samples is None:
-            scale_samples = self._scale_samples(region)
-        self._scale_estimator.learn(scale_samples, 1.0 if restart else k * s.scale_rate)
+        if scale_spectrum is None:
+            scale_spectrum = self._scale_estimator.spectrum(self._scale_samples(region))
+        self._scale_estimator.learn(scale_spectrum, 1.0 if restart else k * s.scale_rate)
 
     def _region(self, frame: np.ndarray) -> _Region:
         """The window around the subject, cut once per position and scale; every patch comes from it."""

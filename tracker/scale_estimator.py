@@ -49,14 +49,19 @@ class ScaleEstimator:
         samples = cv2.remap(grey, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
         return cell_features(samples.reshape(scales, height, width)).reshape(scales, -1)
 
-    def best_step(self, samples: np.ndarray) -> int:
+    def spectrum(self, samples: np.ndarray) -> np.ndarray:
+        """What ``best_step`` and ``learn`` take: the samples' spectrum over the ladder."""
+        return self._filter.spectrum(samples)
+
+    def best_step(self, spectrum: np.ndarray) -> int:
         """Steps from today's size to the best-matching sample, -scales//2 .. scales//2."""
-        step = int(np.argmax(self._filter.respond(samples)))
+        step = int(np.argmax(self._filter.respond(spectrum)))
         return step if step <= self.scales // 2 else step - self.scales
 
-    def learn(self, samples: np.ndarray, rate: float) -> None:
-        """Fold samples centred on the subject's size into the filter (``rate`` 1 restarts)."""
-        self._filter.learn(samples, rate)
+    def learn(self, spectrum: np.ndarray, rate: float) -> None:
+        """Fold the spectrum of samples centred on the subject's size into the filter (``rate`` 1
+        restarts)."""
+        self._filter.learn(spectrum, rate)
 
 
 def _sample_offsets(size: tuple[int, int], factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

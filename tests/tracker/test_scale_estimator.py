@@ -19,9 +19,9 @@ def test_a_subject_zoomed_by_whole_steps_is_found_there(steps):
     image = texture(200, 200, np.random.default_rng(3), cell=6, contrast=0.8)
     centre, subject = (99.5, 99.5), np.array([60.0, 40.0])
     estimator = ScaleEstimator((60.0, 40.0), scales=17, step=1.03)
-    estimator.learn(estimator.samples(image, centre, subject), rate=1.0)
+    estimator.learn(estimator.spectrum(estimator.samples(image, centre, subject)), rate=1.0)
     grown = zoomed(image, 1.03**steps)
-    assert estimator.best_step(estimator.samples(grown, centre, subject)) == steps
+    assert estimator.best_step(estimator.spectrum(estimator.samples(grown, centre, subject))) == steps
 
 
 def test_a_large_subject_is_sampled_at_the_ladders_small_size():
