@@ -49,7 +49,7 @@ def cell_features(grey: np.ndarray) -> np.ndarray:
     grey_level = cv2.resize(grey.reshape(n * height, width), (gw, n * gh), interpolation=cv2.INTER_AREA)
     grey_level = grey_level.reshape(n, gh, gw, 1) - 0.5
     return np.concatenate([np.minimum(signed * scale, _TRUNCATE), np.minimum(unsigned * scale, _TRUNCATE),
-                           grey_level], axis=3).astype(np.float32)
+                           grey_level], axis=3).astype(np.float32, copy=False)
 
 
 def unit_grey(image: np.ndarray) -> np.ndarray:
