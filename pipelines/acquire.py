@@ -2,44 +2,115 @@
 from __future__ import annotations
 
 import math
-from collections import deque
 from collections.abc import Sequence
+from dataclasses import dataclass
 
-from tracker.boxes import iou
+from tracker.boxes import Box, center, iou
 from tracker.detectors import Detection
 
 PICKS = ("central", "largest")
 CAMERA_MOTION_FRACTION = 0.10  # motion over more of the frame than this: the camera moved
 
 
+@dataclass
+class _Candidate:
+    """A detection seen before: its last box, the frame of that sighting, its velocity (box
+    centre px per frame, None until seen twice) and the usable frames it was seen in."""
+
+    box: Box
+    frame: int
+    velocity: tuple[float, float] | None
+    seen: list[int]
+
+    def predicted(self, frame: int) -> Box:
+        """The last box moved on at the candidate's velocity to ``frame`` (held when unknown)."""
+        vx, vy = self.velocity or (0.0, 0.0)
+        x, y, w, h = self.box
+        return (x + vx * (frame - self.frame), y + vy * (frame - self.frame), w, h)
+
+    def see(self, box: Box, frame: int, usable: int) -> None:
+        (cx, cy), (px, py) = center(box), center(self.box)
+        self.velocity = ((cx - px) / (frame - self.frame), (cy - py) / (frame - self.frame))
+        self.box, self.frame = box, frame
+        self.seen.append(usable)
+
+
 class StartConfirmer:
-    """Starts on a detection only once it persists: seen (IoU >= ``min_iou``) in ``needed`` of the
-    last ``window`` usable frames. With ``max_moving_fraction`` (for the motion detector) frames
-    whose detections cover more of the image than that are skipped: the camera itself moved, so
-    a static-camera motion detector says nothing about the subject there."""
+    """Starts on a detection only once it persists: a candidate seen in ``needed`` of the last
+    ``window`` usable frames. A candidate keeps its last box and velocity (its last step), and a
+    detection is its next sighting when it overlaps (IoU >= ``min_iou``) that box where it was or
+    moved on at that velocity, so a subject crossing the picture is confirmed as soon as a still
+    one (comparing raw boxes, one moving a sixth of its width a frame or more was late). A candidate
+    seen once has no velocity yet: its next sighting is one that overlaps it so or, in the very
+    next frame, one of about its size (areas within ``max_area_ratio``) whose centre is at most
+    ``reach`` box sides (square root of its area) away. Detections at random places seldom fall
+    on one line three times: flicker is not confirmed.
+    With ``max_moving_fraction`` (for the motion detector) frames whose detections cover more of
+    the image than that are skipped: the camera itself moved, so a static-camera motion detector
+    says nothing about the subject there."""
 
     def __init__(self, needed: int = 3, window: int = 5, min_iou: float = 0.5,
-                 max_moving_fraction: float | None = None) -> None:
+                 max_moving_fraction: float | None = None, reach: float = 0.5,
+                 max_area_ratio: float = 2.0) -> None:
         self.needed = needed
+        self.window = window
         self.min_iou = min_iou
         self.max_moving_fraction = max_moving_fraction
-        self._recent: deque[Sequence[Detection]] = deque(maxlen=window - 1)
+        self.reach = reach
+        self.max_area_ratio = max_area_ratio
+        self._candidates: list[_Candidate] = []
+        self._frame = -1  # every frame offered: the time a candidate moves in
+        self._usable = -1  # frames not skipped: the window counts these
 
     def offer(self, detections: Sequence[Detection], frame_size: tuple[int, int]) -> list[Detection]:
         """This frame's detections that are confirmed (empty until one persists)."""
+        self._frame += 1
         width, height = frame_size
         covered = sum(d.box[2] * d.box[3] for d in detections) / float(width * height)
         if self.max_moving_fraction is not None and covered > self.max_moving_fraction:
             return []
-        confirmed = [d for d in detections if 1 + sum(
-            any(iou(d.box, seen.box) >= self.min_iou for seen in frame) for frame in self._recent
-        ) >= self.needed]
-        self._recent.append(list(detections))
-        return confirmed
+        self._usable += 1
+        oldest = self._usable - self.window + 1
+        self._candidates = [c for c in self._candidates if c.seen[-1] >= oldest]
+        free = list(detections)
+        confirmed = []
+        for candidate in sorted(self._candidates, key=lambda c: -len(c.seen)):
+            found = self._next_sighting(candidate, free)
+            if found is None:
+                continue
+            free.remove(found)
+            candidate.see(found.box, self._frame, self._usable)
+            if sum(seen >= oldest for seen in candidate.seen) >= self.needed:
+                confirmed.append(found)
+        self._candidates += [_Candidate(d.box, self._frame, None, [self._usable]) for d in free]
+        return [d for d in detections if any(d is c for c in confirmed)]
+
+    def _next_sighting(self, candidate: _Candidate, detections: Sequence[Detection]) -> Detection | None:
+        """The detection that continues ``candidate`` this frame, or None: the one overlapping its
+        last box or its predicted box the most, else (seen once, in the frame before) the nearest
+        one within reach."""
+        predicted = candidate.predicted(self._frame)
+        overlap = {id(d): max(iou(d.box, predicted), iou(d.box, candidate.box)) for d in detections}
+        near = [d for d in detections if overlap[id(d)] >= self.min_iou]
+        if near:
+            return max(near, key=lambda d: overlap[id(d)])
+        if candidate.velocity is not None or self._frame - candidate.frame > 1:
+            return None
+        sx, sy = center(candidate.box)
+        reachable = [d for d in detections if self._within_reach(candidate.box, d.box)]
+        return min(reachable, key=lambda d: math.hypot(center(d.box)[0] - sx, center(d.box)[1] - sy), default=None)
+
+    def _within_reach(self, seen: Box, box: Box) -> bool:
+        """``box`` is of about the size of ``seen`` and its centre at most ``reach`` sides away."""
+        area, seen_area = box[2] * box[3], seen[2] * seen[3]
+        if not seen_area / self.max_area_ratio <= area <= seen_area * self.max_area_ratio:
+            return False
+        (cx, cy), (sx, sy) = center(box), center(seen)
+        return math.hypot(cx - sx, cy - sy) <= self.reach * math.sqrt(seen_area)
 
     def reset(self) -> None:
         """Forget what was seen: the next start must persist on its own."""
-        self._recent.clear()
+        self._candidates.clear()
 
 
 def pick_candidate(detections: Sequence[Detection], frame_size: tuple[int, int],
