@@ -129,10 +129,20 @@ class SubjectTracker:
         best = self._appearance.search(frame, predicted, self._size, reach)
         if self._detector is not None and self._misses > s.lost_after_frames:
             for detection in self._detector.detect(frame):
-                score = self._appearance.similarity(cut_patch(frame, detection.box))
-                if score > best.score:
-                    best = Match(detection.box, score)
+                found = self._in_detection(frame, detection.box)
+                if found.score > best.score:
+                    best = found
         return best
+
+    def _in_detection(self, frame: np.ndarray, box: Box) -> Match:
+        """The subject in a detector's ``box``: the whole box by its likeness, or the best match of
+        the subject's templates at the subject's size inside it (centred on it when it is smaller),
+        whichever looks more like it. A start on part of the subject (a motion box that caught half
+        of it) learnt that part's look, which a box of the whole subject does not resemble."""
+        whole = Match(box, self._appearance.similarity(cut_patch(frame, box)))
+        w, h = self._size
+        inside = self._appearance.search(frame, box, self._size, max(0.0, (box[2] / w - 1) / 2, (box[3] / h - 1) / 2))
+        return inside if inside.score > whole.score else whole
 
     def _estimate(self, confidence: float, state: TrackState, timestamp: float) -> TargetEstimate:
         box = self._kalman.box
