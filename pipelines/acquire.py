@@ -29,6 +29,7 @@ class _Candidate:
         return (x + vx * (frame - self.frame), y + vy * (frame - self.frame), w, h)
 
     def see(self, box: Box, frame: int, usable: int) -> None:
+        """Seen again at ``box`` in ``frame`` (the ``usable``-th frame not skipped)."""
         (cx, cy), (px, py) = center(box), center(self.box)
         self.velocity = ((cx - px) / (frame - self.frame), (cy - py) / (frame - self.frame))
         self.box, self.frame = box, frame
