@@ -109,10 +109,6 @@ class StartConfirmer:
         (cx, cy), (sx, sy) = center(box), center(seen)
         return math.hypot(cx - sx, cy - sy) <= self.reach * math.sqrt(seen_area)
 
-    def reset(self) -> None:
-        """Forget what was seen: the next start must persist on its own."""
-        self._candidates.clear()
-
 
 def pick_candidate(detections: Sequence[Detection], frame_size: tuple[int, int],
                    pick: str = "central") -> Detection | None:
