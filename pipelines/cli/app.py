@@ -11,6 +11,7 @@ import os
 import signal
 import sys
 from collections.abc import Iterable
+from dataclasses import dataclass
 
 from gimbal.signals import SignalExit, blocked_signals, exit_on_signals
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError
@@ -65,10 +66,31 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     """Parse ``argv`` and run the subcommand; its exit status. ``release``: the signal mask to go
     back to once the handlers are in place, when the caller holds the signals already."""
     given = sys.argv[1:] if argv is None else argv
-    prog, debug = "gimbaltrack", "--debug" in given  # until parsed: an OSError may come first
+    run = _Run(debug="--debug" in given)  # until parsed: an OSError may come first
     quiet_opencv(given)
     if sys.stdout is None:  # fd 1 closed (>&-): Python gives no stdout, and print() drops the results
         sys.stdout = ClosedStdout()
+    try:
+        status = _run(argv, release, run)
+    except SystemExit:  # argparse's --help (0) or usage error (2): its text is flushed here, not at exit
+        if failed := _flushed(run, 0):
+            return failed
+        raise
+    return _flushed(run, status)  # after a signal too: what the run printed before it
+
+
+@dataclass
+class _Run:
+    """What the one-line errors of a run name (the command, whether ``--debug`` was given), and
+    whether its results were flushed already (once is enough: a failure is said once)."""
+
+    prog: str = "gimbaltrack"
+    debug: bool = False
+    flushed: bool = False
+
+
+def _run(argv: list[str] | None, release: Iterable[int] | None, run: _Run) -> int:
+    """``main`` but for argparse's exits: the subcommand's status, or the status of how it ended."""
     try:
         with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
             try:
@@ -78,35 +100,45 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
                 if release is not None:  # what arrived while the console script held them comes now
                     signal.pthread_sigmask(signal.SIG_SETMASK, release)
             args = parser.parse_args(argv)
-            prog, debug = f"gimbaltrack {args.command}", args.debug
+            run.prog, run.debug = f"gimbaltrack {args.command}", args.debug
             level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
             logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
             try:
                 status = int(args.func(args) or 0)
-                try:
-                    sys.stdout.flush()  # a failure to write the results shows here, not at exit
-                except BrokenPipeError:  # the reader left: the run's own status still stands (130, ...)
-                    _drop_stdout()
-                except OSError as exc:  # a full disk, a closed stdout: said, and a run that was stopped
-                    failed = _unwritten(prog, exc, debug)  # or failed keeps its status (130, ...)
-                    return status or failed
-                return status
             except CliError as exc:
                 if args.debug:
                     raise
-                print(f"{prog}: error: {exc}", file=sys.stderr)
-                return exc.exit_code
+                print(f"{run.prog}: error: {exc}", file=sys.stderr)
+                status = exc.exit_code
+            return _flushed(run, status)  # here too: a Ctrl-C while a slow reader holds it is handled
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
+        print(f"{run.prog}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except SignalExit as exc:
-        print(f"{prog}: terminated ({exc.signal_name})", file=sys.stderr)
+        print(f"{run.prog}: terminated ({exc.signal_name})", file=sys.stderr)
         return int(exc.code)
     except BrokenPipeError:  # the reader went away (e.g. `| head`): not an error of ours
         _drop_stdout()
         return 0
     except OSError as exc:  # one no subcommand words itself, e.g. stdout on a full disk (> /dev/full)
-        return _unwritten(prog, exc, debug)
+        return _unwritten(run.prog, exc, run.debug)
+
+
+def _flushed(run: _Run, status: int) -> int:
+    """``status`` once the results are flushed (a failure to write them shows here, not at exit):
+    a reader that left changes nothing; a full disk or a closed stdout is a line, and exit 1
+    unless the run ended with its own status already (130, 2, ...)."""
+    if run.flushed:
+        return status
+    run.flushed = True
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _drop_stdout()
+    except OSError as exc:
+        failed = _unwritten(run.prog, exc, run.debug)  # said whatever the status
+        return status or failed
+    return status
 
 
 def _unwritten(prog: str, exc: OSError, debug: bool) -> int:

@@ -101,3 +101,23 @@ def test_results_that_cannot_be_written_leave_a_stopped_runs_status(
         monkeypatch.setattr(sys, "stdout", Unwritable())
         assert main(["decode", "--hex", "AA"]) == 130
     assert capsys.readouterr().err == f"gimbaltrack decode: error: {error}\n"
+
+
+def test_help_to_a_closed_stdout_is_one_line_and_exit_1() -> None:
+    """argparse's --help leaves by SystemExit(0): the text it wrote was flushed only at exit,
+    an 'Exception ignored' traceback and exit 120."""
+    done = subprocess.run(_closed_stdout(cli_command("decode", "--help")), stderr=subprocess.PIPE,
+                          text=True, env=subprocess_env(), timeout=60)
+    assert (done.returncode, done.stderr) == (1, f"gimbaltrack{CLOSED}")
+
+
+def test_an_error_after_results_to_a_closed_stdout_keeps_its_status(tmp_path: Path) -> None:
+    """A run that printed results and then failed in its own words (a log unreadable after two
+    frames): its status and its line stand, and the unwritten results are one more line."""
+    log = tmp_path / "cut.log"
+    log.write_text("(0.0) can0 223#AA1A000300000000\n(0.1) can0 223#0102030405060708\nnot a frame\n")
+    done = subprocess.run(_closed_stdout(cli_command("decode", str(log))), stderr=subprocess.PIPE,
+                          text=True, env=subprocess_env(), timeout=60)
+    assert done.returncode == 2
+    assert done.stderr.splitlines()[1:] == [f"gimbaltrack decode{CLOSED}".rstrip("\n")]
+    assert "unreadable after frame 2" in done.stderr.splitlines()[0]
