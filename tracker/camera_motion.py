@@ -10,7 +10,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-FIT_SIDE = 400  # images longer than this are halved for the fit (a third of its cost; sub-pixel anyway)
+FIT_SIDE = 400  # images longer than this (and 2 px high and wide) are halved for the fit (a third of its cost)
 MAX_CORNERS = 100
 MIN_INLIERS = 20  # fewer corners agreeing on one motion: the camera's motion cannot be told
 MIN_INLIER_SHARE = 0.3  # ... or fewer than this share of the corners followed
@@ -25,7 +25,7 @@ def camera_motion(older: np.ndarray, newer: np.ndarray) -> np.ndarray | None:
     ``uint8`` grey), or None when the camera stood still or its motion cannot be told (too few
     corners, or too few of them agreeing)."""
     shape = older.shape
-    factor = 2.0 if max(shape) > FIT_SIDE else 1.0
+    factor = 2.0 if max(shape) > FIT_SIDE and min(shape[:2]) >= 2 else 1.0  # a 1 px side cannot be halved
     if factor > 1.0:
         older, newer = (cv2.resize(i, None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA) for i in (older, newer))
     corners = cv2.goodFeaturesToTrack(older, MAX_CORNERS, 0.01, max(4, max(older.shape) // 40), blockSize=5)
