@@ -15,6 +15,7 @@ import can
 from gimbal.messages.motion import AXES
 from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
 from gimbal.sim.checks import FieldError
+from gimbal.sim.config import MAX_PUSH_RATE_HZ
 from gimbal.sim.faults import DIRECTIONS
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
@@ -32,7 +33,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     model = parser.add_argument_group("device")
     model.add_argument("--legacy", action="store_true", help="old firmware: replies omit CmdSet/CmdID")
     model.add_argument("--push-rate", type=float, default=SimConfig.push_rate_hz, metavar="HZ",
-                       help="parameter push rate once enabled (default %(default)s)")
+                       help=f"parameter push rate once enabled, above 0 up to {MAX_PUSH_RATE_HZ:g} (default %(default)s)")
     model.add_argument("--accel", type=float, default=SimConfig.accel_dps2, metavar="DPS2",
                        help="axis acceleration limit in °/s² (default %(default)s)")
     model.add_argument("--base-yaw", type=float, default=SimConfig.base_yaw_deg, metavar="DEG",

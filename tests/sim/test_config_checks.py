@@ -18,6 +18,8 @@ NAN, INF = math.nan, math.inf
     ("max_speed_dps", INF), ("speed_timeout_s", INF), ("calibration_s", NAN), ("calibration_s", -1.0),
     ("focus_calibration_s", INF), ("initial_joint_deg", (0.0, NAN, 0.0)), ("initial_joint_deg", (0.0, 0.0)),
     ("rx_id", 0x800), ("tx_id", -1), ("device_id", 0), ("version", 1 << 32), ("speed_signs", (1, 0, 1)),
+    # 1e300 Hz once pushed ~10,000 times a second: 50,000 frames, several times what the bus carries
+    ("push_rate_hz", 1e300), ("push_rate_hz", 1000.5), ("calibration_push_hz", 1e300),
 ])
 def test_sim_config_refuses(field: str, value: object) -> None:
     with pytest.raises(FieldError, match=rf"^SimConfig\.{field} takes .*, not ") as caught:
@@ -36,5 +38,6 @@ def test_faults_refuse(field: str, value: object) -> None:
 
 
 def test_the_edges_are_taken() -> None:
-    SimConfig(calibration_s=0.0, base_yaw_deg=-720.0, rx_id=0x7FF, tx_id=0, version=0xFFFFFFFF)
+    SimConfig(calibration_s=0.0, base_yaw_deg=-720.0, rx_id=0x7FF, tx_id=0, version=0xFFFFFFFF,
+              push_rate_hz=1000.0, calibration_push_hz=1000.0)
     Faults(drop=1.0, delay_s=0.0, nack_code=0xFF, foreign_rate=20_000, silent=(5.0, INF))  # silent to the end

@@ -116,11 +116,13 @@ def test_duration_status_lines_and_json(capsys) -> None:
 
 
 FOREIGN_RATE = "--foreign-rate takes a rate from 0 to 20000 Hz (a 1 Mbit/s bus carries less)"
+PUSH_RATE = "--push-rate takes a rate above 0 Hz, at most 1000 Hz (a push takes several frames of a 1 Mbit/s bus)"
 
 
 @pytest.mark.parametrize("args, message", [
     (["--drop", "1.5"], "--drop takes a fraction from 0 to 1, not 1.5"),
-    (["--push-rate", "0"], "--push-rate takes a finite rate above 0 Hz, not 0"),
+    (["--push-rate", "0"], f"{PUSH_RATE}, not 0"),
+    (["--push-rate", "1e300", "--duration", "0.2"], f"{PUSH_RATE}, not 1e+300"),  # once flooded the bus
     # NaN once passed every check and stopped the simulator's threads; the words were SimConfig's
     (["--delay-ms", "nan"], "--delay-ms takes a finite delay, 0 or more, not nan"),
     (["--delay-ms=-5"], "--delay-ms takes a finite delay, 0 or more, not -5"),  # the option's unit, not Faults'
@@ -128,7 +130,7 @@ FOREIGN_RATE = "--foreign-rate takes a rate from 0 to 20000 Hz (a 1 Mbit/s bus c
     (["--base-yaw", "nan"], "--base-yaw takes a finite angle, not nan"),
     (["--foreign-rate", "nan"], f"{FOREIGN_RATE}, not nan"),
     (["--foreign-rate", "1e300"], f"{FOREIGN_RATE}, not 1e+300"),  # once let through: that many frames a tick
-    (["--push-rate", "inf"], "--push-rate takes a finite rate above 0 Hz, not inf"),
+    (["--push-rate", "inf"], f"{PUSH_RATE}, not inf"),
     (["--calibration-time", "-1"], "--calibration-time takes a finite time, 0 s or more, not -1"),
     (["--status-interval", "nan"], "--status-interval takes a finite interval, 0 s or more, not nan"),
     (["--nack-code", "999"], "--nack-code takes a byte, 0 to 0xFF, not 999"),
