@@ -67,6 +67,8 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     back to once the handlers are in place, when the caller holds the signals already."""
     given = sys.argv[1:] if argv is None else argv
     run = _Run(debug="--debug" in given)  # until parsed: an OSError may come first
+    if sys.stderr is None:  # fd 2 closed (2>&-): print(file=None) wrote the errors among the results
+        sys.stderr = closed_stderr()
     quiet_opencv(given)
     if sys.stdout is None:  # fd 1 closed (>&-): Python gives no stdout, and print() drops the results
         sys.stdout = ClosedStdout()
@@ -154,7 +156,24 @@ def _unwritten(prog: str, exc: OSError, debug: bool) -> int:
     return 1
 
 
-STDOUT_FD = 1
+STDOUT_FD, STDERR_FD = 1, 2
+
+
+def hold_on_devnull(fd: int) -> None:
+    """Open /dev/null on ``fd``, closed when the program started, so that no output file opened
+    later takes that number (and gets what is written to stdout or stderr, OpenCV's own included)."""
+    null = os.open(os.devnull, os.O_WRONLY)
+    if null != fd:
+        os.dup2(null, fd)
+        os.close(null)
+
+
+def closed_stderr() -> io.TextIOBase:
+    """``sys.stderr`` when fd 2 was closed (``2>&-``), where Python gives None and ``print(...,
+    file=sys.stderr)`` writes to stdout: the user chose not to see the errors, so they go to
+    /dev/null, never among the results; the exit status still tells a failure."""
+    hold_on_devnull(STDERR_FD)
+    return open(STDERR_FD, "w", closefd=False)
 
 
 class ClosedStdout(io.TextIOBase):
@@ -164,10 +183,7 @@ class ClosedStdout(io.TextIOBase):
 
     def __init__(self) -> None:
         super().__init__()
-        null = os.open(os.devnull, os.O_WRONLY)
-        if null != STDOUT_FD:
-            os.dup2(null, STDOUT_FD)
-            os.close(null)
+        hold_on_devnull(STDOUT_FD)
         self._written = False
 
     def writable(self) -> bool:
