@@ -64,12 +64,20 @@ def simulated_gimbal(args: argparse.Namespace) -> Iterator[tuple[can.BusABC, Sim
     if args.channel is not None or args.bitrate is not None:
         raise CliError("the built-in simulated gimbal (-i sim, and track's default) takes no -c/--channel or "
                        "-b/--bitrate: give -i with a python-can interface for a real bus")
+    check_sim_ids(args)
     host_bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id))
     try:
         yield host_bus, sim
     finally:
         sim.stop()
         host_bus.shutdown()
+
+
+def check_sim_ids(args: argparse.Namespace) -> None:
+    """The simulated gimbal (``sim``, ``-i sim``) listens on --tx-id and answers on --rx-id: one
+    id for both is refused up front (it once ended in "the gimbal does not answer", exit 1)."""
+    if args.tx_id == args.rx_id:
+        raise CliError(f"--tx-id and --rx-id must differ (both 0x{args.tx_id:03X})")
 
 
 def _one_line(exc: BaseException) -> str:

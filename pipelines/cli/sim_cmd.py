@@ -17,7 +17,7 @@ from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
 from gimbal.sim.checks import FieldError
 from gimbal.sim.config import MAX_PUSH_RATE_HZ
 from gimbal.sim.faults import DIRECTIONS
-from pipelines.cli.bus import SIM_INTERFACE, bus_options, open_can_bus
+from pipelines.cli.bus import SIM_INTERFACE, bus_options, check_sim_ids, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
 
 
@@ -139,8 +139,7 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
         raise CliError(f"--status-interval takes a finite interval, 0 s or more, not {args.status_interval:g}")
     if args.duration is not None and args.duration <= 0:
         raise CliError(f"--duration must be positive, not {args.duration}")
-    if args.tx_id == args.rx_id:
-        raise CliError(f"--tx-id and --rx-id must differ (both 0x{args.tx_id:03X})")
+    check_sim_ids(args)
     return config, faults
 
 
