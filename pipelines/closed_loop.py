@@ -22,10 +22,10 @@ from gimbal.client import GimbalClient
 from gimbal.messages.telemetry import ParameterPush
 from gimbal.sim import SimConfig, start_in_process
 from pipelines.control.attitude import AttitudeHistory
-from pipelines.control.controller import ControlConfig, RateCommand, make_controller
+from pipelines.control.controller import ControlConfig, Controller, RateCommand, make_controller
 from pipelines.control.metrics import CentringSample, summarize
 from pipelines.virtual_camera import VirtualCamera
-from tracker import make_tracker
+from tracker import SubjectTracker, make_tracker
 from tracker.boxes import Box, center
 from tracker.datasets import Sequence, load_sequence
 from tracker.estimate import TargetEstimate, TrackState
@@ -115,16 +115,44 @@ def _check_truth(seq: Sequence, tracked: bool) -> None:
         first_box(seq)
 
 
-def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> LoopResult:
-    """Run ``sequence`` (a folder or video with ground truth) through the loop; see the module doc."""
+@dataclass
+class PreparedLoop:
+    """A sequence loaded and checked, its first frame read, and the view, controller and tracker
+    made: what a bad sequence or setting fails, it fails in ``prepare_loop``, before anything runs
+    (or a front end creates its output folder)."""
+
+    settings: LoopSettings
+    seq: Sequence
+    frames: Iterator[np.ndarray]  # from the second frame on
+    first: np.ndarray
+    vc: VirtualCamera
+    controller: Controller
+    subject: SubjectTracker | None  # None: the oracle
+
+
+def prepare_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> PreparedLoop:
+    """``sequence`` (a folder or video with ground truth) ready to run; ValueError or
+    FileNotFoundError for a bad one."""
     seq = load_sequence(sequence)
     _check_truth(seq, tracked=settings.tracker != ORACLE)
     frames: Iterator[np.ndarray] = seq.frames()
     first = next(frames)
     vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
     controller = make_controller(settings.controller, camera=vc.camera, config=settings.control)
-    oracle = OracleTracker(vc.camera.width, vc.camera.height)
     subject = None if settings.tracker == ORACLE else make_tracker(settings.tracker, settings.model_dir)
+    return PreparedLoop(settings, seq, frames, first, vc, controller, subject)
+
+
+def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> LoopResult:
+    """Run ``sequence`` (a folder or video with ground truth) through the loop; see the module doc."""
+    return run_prepared(prepare_loop(sequence, settings))
+
+
+def run_prepared(loop: PreparedLoop) -> LoopResult:
+    """Run a prepared loop; see the module doc."""
+    settings, seq, frames, first, vc = loop.settings, loop.seq, loop.frames, loop.first, loop.vc
+    controller, subject = loop.controller, loop.subject
+    oracle = OracleTracker(vc.camera.width, vc.camera.height)
 
     host_bus, sim = start_in_process(SimConfig(yaw_continuous=True))
     steps: list[LoopStep] = []

@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, run_closed_loop
+from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, prepare_loop, run_prepared
 from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
 from pipelines.control.controller import controller_names
 from pipelines.control.metrics import MAX_ERROR, OVERSHOOT_WINDOW_S
@@ -102,9 +102,10 @@ def run(args: argparse.Namespace) -> int:
                             out_size=args.size, latency_s=args.latency / 1000.0, fps=args.fps,
                             model_dir=args.model_dir)
     try:
+        loop = prepare_loop(args.sequence, settings)  # a bad sequence fails before --out is created
         if args.out:
             make_out_dir(args.out)
-        result = run_closed_loop(args.sequence, settings)
+        result = run_prepared(loop)
     except (FileNotFoundError, ValueError) as exc:
         raise CliError(str(exc)) from exc
     except (KeyboardInterrupt, SystemExit):  # Ctrl-C, or SIGTERM/SIGHUP/SIGQUIT turned into SystemExit

@@ -23,7 +23,7 @@ from gimbal.messages.tlv_params import CalibrationStatusPush, SetUserParams, Set
 from pipelines.cli import main
 from pipelines.cli.gimbal_cmd import register
 from tests.gimbal.scripted_peer import RELEASE, ZERO, ScriptedPeer, poll, speed_messages
-from tests.support import cli_command, free_udp_port, subprocess_env
+from tests.support import ROOT, cli_command, free_udp_port, subprocess_env
 
 DOC_EXAMPLE = "AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE"
 
@@ -359,7 +359,9 @@ def test_the_filesystem_root_is_no_output_folder(text: str) -> None:
 def test_an_output_folder_in_a_symlink_loop_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The root check resolved the path, and a symlink loop made that a RuntimeError traceback."""
     (tmp_path / "loop").symlink_to(tmp_path / "loop")
-    assert main(["simulate", str(tmp_path), "--out", str(tmp_path / "loop" / "x")]) == 2
+    # a good sequence: it is checked before the output folder is made
+    assert main(["simulate", str(ROOT / "samples" / "demo.mp4"), "--tracker", "oracle",
+                 "--out", str(tmp_path / "loop" / "x")]) == 2
     assert "cannot create output folder" in capsys.readouterr().err
 
 

@@ -165,3 +165,18 @@ def test_sigterm_exits_143_and_says_nothing_was_written(sequence: Path, tmp_path
     assert stderr == (f"gimbaltrack simulate: note: stopped before the end, nothing written to {out}\n"
                       "gimbaltrack simulate: terminated (SIGTERM)\n")
     assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize("bad", ["missing", "no_frames", "no_truth"])
+def test_a_bad_sequence_creates_no_out_folder(bad: str, sequence: Path, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """The sequence is checked before --out is made, as ``track`` checks its source (the folder
+    was once left behind, empty, by a run that never started)."""
+    folder, out = tmp_path / bad, tmp_path / "out" / "run"
+    if bad != "missing":
+        folder.mkdir()
+    if bad == "no_truth":
+        shutil.copy(sequence / "1.png", folder / "1.png")
+    code, stdout, err = simulate([str(folder), "--out", str(out)], capsys)
+    assert (code, stdout, err.count("\n")) == (2, "", 1) and err.startswith("gimbaltrack simulate: error: ")
+    assert not (tmp_path / "out").exists()
