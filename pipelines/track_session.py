@@ -29,7 +29,7 @@ from pipelines.outputs.summary import write_summary
 from pipelines.outputs.telemetry import TelemetryWriter, estimate_fields
 from pipelines.progress import ProgressReporter
 from pipelines.sources import Frame, FrameSource
-from tracker import make_tracker
+from tracker import SubjectTracker, make_tracker
 from tracker.detectors import Detector, make_detector
 from tracker.datasets import ASSUMED_FPS
 from tracker.estimate import TargetEstimate
@@ -102,11 +102,21 @@ def signed_attitude(yaw: float, pitch: float, options: TrackOptions) -> tuple[fl
     return yaw * options.yaw_attitude_sign, pitch * options.pitch_attitude_sign
 
 
+def make_subject(options: TrackOptions) -> tuple[Detector | None, SubjectTracker]:
+    """The run's detector (None without ``detect``) and tracker, which runs the detector itself on
+    every frame while the subject is lost. Missing model files or an unknown name raise
+    FileNotFoundError or ValueError: a front end makes them before it creates the output folder."""
+    detector = make_detector(options.detect, options.model_dir) if options.detect else None
+    return detector, make_tracker(options.tracker, options.model_dir, detector)
+
+
 class TrackSession:
-    """One tracking run against an open source and an open gimbal client."""
+    """One tracking run against an open source and an open gimbal client; ``subject`` is
+    ``make_subject(options)``."""
 
     def __init__(self, options: TrackOptions, source: FrameSource, client: GimbalClient,
-                 bus_description: str, can_log: CanLogWriter | None = None) -> None:
+                 bus_description: str, subject: tuple[Detector | None, SubjectTracker],
+                 can_log: CanLogWriter | None = None) -> None:
         self.options = options
         self.can_log = can_log  # the bus's log: its write failure ends the run (OSError)
         self.source = source
@@ -116,10 +126,7 @@ class TrackSession:
         self.camera = CameraModel(width, height, hfov_deg=options.hfov_deg)
         self.controller = make_controller(options.controller, camera=self.camera,
                                           config=control_config(options.max_speed_dps))
-        self.detector: Detector | None = (make_detector(options.detect, options.model_dir)
-                                          if options.detect else None)
-        # the tracker runs the detector itself, on every frame while the subject is lost
-        self.tracker = make_tracker(options.tracker, options.model_dir, self.detector)
+        self.detector, self.tracker = subject
         self._confirmer = StartConfirmer(
             max_moving_fraction=CAMERA_MOTION_FRACTION if options.detect == "motion" else None)
         self.feedback = (source.is_live if options.attitude_feedback == "auto"

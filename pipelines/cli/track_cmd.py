@@ -20,8 +20,9 @@ from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter, LoggingBus
 from pipelines.sources import FrameSource, SourceError, open_source
-from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession
-from tracker import available_trackers
+from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
+from tracker import SubjectTracker, available_trackers
+from tracker.detectors import Detector
 
 DEFAULT_DETECTOR = "motion"
 
@@ -148,11 +149,12 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
         if ignored:
             print(f"gimbaltrack track: note: ignoring {' and '.join(ignored)} for a live source (it runs at "
                   "its own rate)", file=sys.stderr)
-        if options.roi is not None:
-            try:
+        try:
+            if options.roi is not None:
                 check_roi_in_frame(options.roi, source.size)
-            except ValueError as exc:
-                raise CliError(str(exc)) from None
+            subject = make_subject(options)  # missing model files fail before --out is created
+        except (ValueError, OSError) as exc:
+            raise CliError(str(exc)) from None
         with open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
@@ -166,7 +168,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                              " ".join(str(v) for v in (args.interface or "python-can's configured bus",
                                                        args.channel) if v))
                     try:
-                        session = _session(options, source, client, where, can_log, held)
+                        session = _session(options, source, client, where, subject, can_log, held)
                     except CliError:  # it says why the run ended; a signal held meanwhile adds nothing
                         pending_signals.clear()
                         raise
@@ -183,9 +185,10 @@ def _can_log(path: Path) -> CanLogWriter:
 
 
 def _session(options: TrackOptions, source: FrameSource, client: GimbalClient, where: str,
-             can_log: CanLogWriter, held_signals: ExitStack) -> TrackSession:
+             subject: tuple[Detector | None, SubjectTracker], can_log: CanLogWriter,
+             held_signals: ExitStack) -> TrackSession:
     try:
-        session = TrackSession(options, source, client, where, can_log)
+        session = TrackSession(options, source, client, where, subject, can_log)
     except (ValueError, FileNotFoundError, OSError) as exc:
         raise CliError(str(exc)) from None
     try:

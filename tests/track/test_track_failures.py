@@ -73,6 +73,16 @@ def test_wrong_model_files_are_named_in_one_line(tmp_path: Path, capsys: pytest.
     models = fake_onnx.write_nanotrack_files(tmp_path / "models", backbone, head)  # once a cv2.error traceback
     assert run_track(DEMO, tmp_path / "out", "--roi", DEMO_ROI, "--model-dir", str(models)) == 2
     _one_line_error(capsys, wrong)
+    assert not (tmp_path / "out").exists()  # checked before it is created, as the source is
+
+
+def test_missing_model_files_create_no_out_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The tracker was once made after --out and its can.log: the folder was left behind."""
+    (tmp_path / "models").mkdir()
+    assert run_track(DEMO, tmp_path / "out", "--roi", DEMO_ROI, "--tracker", "nanotrack",
+                     "--model-dir", str(tmp_path / "models")) == 2
+    _one_line_error(capsys, "NanoTrack: no nanotrack_backbone*.onnx in")
+    assert not (tmp_path / "out").exists()
 
 
 def test_missing_and_garbage_sources(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
