@@ -26,13 +26,14 @@ from pipelines.control.controller import ControlConfig, Controller, RateCommand,
 from pipelines.control.metrics import CentringSample, summarize
 from pipelines.virtual_camera import VirtualCamera
 from tracker import SubjectTracker, make_tracker
-from tracker.boxes import Box, center
+from tracker.boxes import Box, center, start_box
 from tracker.datasets import Sequence, load_sequence
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.evaluation import first_box
 from tracker.metrics import has_truth
 
 ORACLE = "oracle"
+SIM_CONFIG = SimConfig(yaw_continuous=True)  # the simulated gimbal the loop turns
 
 
 @dataclass(frozen=True)
@@ -140,6 +141,12 @@ def prepare_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) 
     vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
     controller = make_controller(settings.controller, camera=vc.camera, config=settings.control)
     subject = None if settings.tracker == ORACLE else make_tracker(settings.tracker, settings.model_dir)
+    if subject is not None:  # the tracker starts on the first view, taken at the gimbal's start pose
+        joint_yaw, _, pitch = SIM_CONFIG.initial_joint_deg
+        view_box = vc.box_to_view(first_box(seq), joint_yaw + SIM_CONFIG.base_yaw_deg, pitch)
+        if view_box is None:
+            raise ValueError(f"{seq.name}: the first ground-truth box is behind the view")
+        start_box(view_box, *settings.out_size)
     return PreparedLoop(settings, seq, frames, first, vc, controller, subject)
 
 
@@ -154,7 +161,7 @@ def run_prepared(loop: PreparedLoop) -> LoopResult:
     controller, subject = loop.controller, loop.subject
     oracle = OracleTracker(vc.camera.width, vc.camera.height)
 
-    host_bus, sim = start_in_process(SimConfig(yaw_continuous=True))
+    host_bus, sim = start_in_process(SIM_CONFIG)
     steps: list[LoopStep] = []
     try:
         with GimbalClient(host_bus) as client:

@@ -180,3 +180,11 @@ def test_a_bad_sequence_creates_no_out_folder(bad: str, sequence: Path, tmp_path
     code, stdout, err = simulate([str(folder), "--out", str(out)], capsys)
     assert (code, stdout, err.count("\n")) == (2, "", 1) and err.startswith("gimbaltrack simulate: error: ")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_start_box_outside_the_first_view_creates_no_out_folder(sequence: Path, tmp_path: Path,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    code, _, err = simulate([str(sequence), "--size", "320x180", "--fps", "60", "--out", str(out)], capsys)
+    assert code == 2 and "lies outside the 320x180 frame" in err and err.count("\n") == 1
+    assert not out.exists()
