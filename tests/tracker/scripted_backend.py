@@ -7,7 +7,7 @@ from collections.abc import Callable
 import numpy as np
 
 from tracker.boxes import Box
-from tracker.detectors import Detector
+from tracker.detectors import Detection, Detector
 from tracker.estimate import TargetEstimate
 from tracker.subject import SubjectTracker, TrackerSettings
 from tracker.synthetic import SyntheticSequence, texture
@@ -78,3 +78,14 @@ def wide_scene(places: list[Box | None]) -> list[np.ndarray]:
             frame[y:y + 40, x:x + 40] = look
         frames.append(frame)
     return frames
+
+
+class BackgroundAndSubject:
+    """A detector that proposes a patch of ``background`` and, while ``subject_in_view``, ``subject``."""
+
+    def __init__(self, background: Box, subject: Box) -> None:
+        self.background, self.subject = background, subject
+        self.subject_in_view = True
+
+    def detect(self, frame: np.ndarray) -> list[Detection]:
+        return [Detection(self.background, 0.9)] + ([Detection(self.subject, 0.8)] if self.subject_in_view else [])

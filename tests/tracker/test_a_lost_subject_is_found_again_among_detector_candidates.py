@@ -3,11 +3,8 @@ compared with its look, and the tracker restarts on the one that looks like it, 
 the template search's reach."""
 from __future__ import annotations
 
-import numpy as np
-
-from tests.tracker.scripted_backend import follow, scripted_tracker, wide_scene
+from tests.tracker.scripted_backend import BackgroundAndSubject, follow, scripted_tracker, wide_scene
 from tracker.boxes import iou
-from tracker.detectors import Detection
 from tracker.estimate import TrackState
 
 BEFORE, AFTER = (100.0, 220.0, 40.0, 40.0), (520.0, 220.0, 40.0, 40.0)  # 420 px apart: past max_reach
@@ -15,19 +12,9 @@ ELSEWHERE = (300.0, 60.0, 40.0, 40.0)  # a patch of background
 GONE, BACK = 5, 21  # the subject is out of the picture on frames GONE..BACK - 1
 
 
-class _Candidates:
-    """A detector that proposes a patch of background and, when the subject is in view, the subject."""
-
-    def __init__(self) -> None:
-        self.subject_in_view = True
-
-    def detect(self, frame: np.ndarray) -> list[Detection]:
-        return [Detection(ELSEWHERE, 0.9)] + ([Detection(AFTER, 0.8)] if self.subject_in_view else [])
-
-
 def test_a_lost_subject_is_restarted_on_the_candidate_that_looks_like_it() -> None:
     frames = wide_scene([BEFORE] * GONE + [None] * (BACK - GONE) + [AFTER] * 5)
-    detector = _Candidates()
+    detector = BackgroundAndSubject(ELSEWHERE, AFTER)
     subject, backend = scripted_tracker(lambda n, restarts: (BEFORE, 0.9) if n < GONE else
                                         (AFTER, 0.9) if restarts else (None, 0.0), detector)
     subject.init(frames[0], BEFORE, 0.0)

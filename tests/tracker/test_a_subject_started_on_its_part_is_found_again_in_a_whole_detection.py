@@ -5,11 +5,8 @@ each detection, and restarts on the part where it is found; a detection of somet
 does not qualify."""
 from __future__ import annotations
 
-import numpy as np
-
-from tests.tracker.scripted_backend import follow, scripted_tracker, wide_scene
+from tests.tracker.scripted_backend import BackgroundAndSubject, follow, scripted_tracker, wide_scene
 from tracker.boxes import iou
-from tracker.detectors import Detection
 from tracker.estimate import TrackState
 
 PART = (100.0, 220.0, 20.0, 40.0)  # the left half of the 40 px subject at (100, 220)
@@ -19,19 +16,9 @@ ELSEWHERE = (300.0, 60.0, 40.0, 40.0)  # a patch of background
 GONE, BACK = 5, 21  # the subject is out of the picture on frames GONE..BACK - 1
 
 
-class _Candidates:
-    """A detector that proposes a patch of background and, when the subject is in view, its whole box."""
-
-    def __init__(self) -> None:
-        self.subject_in_view = True
-
-    def detect(self, frame: np.ndarray) -> list[Detection]:
-        return [Detection(ELSEWHERE, 0.9)] + ([Detection(WHOLE_AFTER, 0.8)] if self.subject_in_view else [])
-
-
 def test_a_subject_started_on_its_part_is_restarted_on_that_part_of_a_whole_detection() -> None:
     frames = wide_scene([(100.0, 220.0, 40.0, 40.0)] * GONE + [None] * (BACK - GONE) + [WHOLE_AFTER] * 5)
-    detector = _Candidates()
+    detector = BackgroundAndSubject(ELSEWHERE, WHOLE_AFTER)
     subject, backend = scripted_tracker(lambda n, restarts: (PART, 0.9) if n < GONE else
                                         (PART_AFTER, 0.9) if restarts else (None, 0.0), detector)
     subject.init(frames[0], PART, 0.0)
