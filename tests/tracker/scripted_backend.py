@@ -8,7 +8,7 @@ import numpy as np
 
 from tracker.boxes import Box
 from tracker.detectors import Detection, Detector
-from tracker.estimate import TargetEstimate
+from tracker.estimate import TargetEstimate, TrackState
 from tracker.subject import SubjectTracker, TrackerSettings
 from tracker.synthetic import SyntheticSequence, texture
 
@@ -89,3 +89,18 @@ class BackgroundAndSubject:
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
         return [Detection(self.background, 0.9)] + ([Detection(self.subject, 0.8)] if self.subject_in_view else [])
+
+
+def restarted_by_detection(frames: list[np.ndarray], gone: int, back: int, start: Box, restarted: Box,
+                           detector: BackgroundAndSubject) -> tuple[list[TargetEstimate], list[int]]:
+    """A scripted tracker started on ``start``: its backend follows until frame ``gone``, then finds
+    nothing, and answers ``restarted`` once it has been restarted; the ``detector`` sees the subject
+    from frame ``back`` on. Checks the subject was LOST before ``back``; the estimates from ``back``
+    on and the frames of the backend's (re)starts."""
+    subject, backend = scripted_tracker(lambda n, restarts: (start, 0.9) if n < gone else
+                                        (restarted, 0.9) if restarts else (None, 0.0), detector)
+    subject.init(frames[0], start, 0.0)
+    detector.subject_in_view = False
+    assert follow(subject, frames[1:back])[-1].state is TrackState.LOST
+    detector.subject_in_view = True
+    return follow(subject, frames[back:], first=back), backend.inits

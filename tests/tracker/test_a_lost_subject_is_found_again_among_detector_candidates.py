@@ -3,7 +3,7 @@ compared with its look, and the tracker restarts on the one that looks like it, 
 the template search's reach."""
 from __future__ import annotations
 
-from tests.tracker.scripted_backend import BackgroundAndSubject, follow, scripted_tracker, wide_scene
+from tests.tracker.scripted_backend import BackgroundAndSubject, restarted_by_detection, wide_scene
 from tracker.boxes import iou
 from tracker.estimate import TrackState
 
@@ -15,14 +15,7 @@ GONE, BACK = 5, 21  # the subject is out of the picture on frames GONE..BACK - 1
 def test_a_lost_subject_is_restarted_on_the_candidate_that_looks_like_it() -> None:
     frames = wide_scene([BEFORE] * GONE + [None] * (BACK - GONE) + [AFTER] * 5)
     detector = BackgroundAndSubject(ELSEWHERE, AFTER)
-    subject, backend = scripted_tracker(lambda n, restarts: (BEFORE, 0.9) if n < GONE else
-                                        (AFTER, 0.9) if restarts else (None, 0.0), detector)
-    subject.init(frames[0], BEFORE, 0.0)
-    detector.subject_in_view = False
-    away = follow(subject, frames[1:BACK])
-    assert away[-1].state is TrackState.LOST
-    detector.subject_in_view = True
-    back = follow(subject, frames[BACK:], first=BACK)
-    assert backend.inits == [0, BACK]
+    back, inits = restarted_by_detection(frames, GONE, BACK, BEFORE, AFTER, detector)
+    assert inits == [0, BACK]
     assert all(e.state is TrackState.TRACKING for e in back)
     assert iou(back[0].box, AFTER) > 0.9

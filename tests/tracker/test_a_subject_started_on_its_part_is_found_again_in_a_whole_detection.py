@@ -5,7 +5,7 @@ each detection, and restarts on the part where it is found; a detection of somet
 does not qualify."""
 from __future__ import annotations
 
-from tests.tracker.scripted_backend import BackgroundAndSubject, follow, scripted_tracker, wide_scene
+from tests.tracker.scripted_backend import BackgroundAndSubject, restarted_by_detection, wide_scene
 from tracker.boxes import iou
 from tracker.estimate import TrackState
 
@@ -19,14 +19,7 @@ GONE, BACK = 5, 21  # the subject is out of the picture on frames GONE..BACK - 1
 def test_a_subject_started_on_its_part_is_restarted_on_that_part_of_a_whole_detection() -> None:
     frames = wide_scene([(100.0, 220.0, 40.0, 40.0)] * GONE + [None] * (BACK - GONE) + [WHOLE_AFTER] * 5)
     detector = BackgroundAndSubject(ELSEWHERE, WHOLE_AFTER)
-    subject, backend = scripted_tracker(lambda n, restarts: (PART, 0.9) if n < GONE else
-                                        (PART_AFTER, 0.9) if restarts else (None, 0.0), detector)
-    subject.init(frames[0], PART, 0.0)
-    detector.subject_in_view = False
-    away = follow(subject, frames[1:BACK])
-    assert away[-1].state is TrackState.LOST
-    detector.subject_in_view = True
-    back = follow(subject, frames[BACK:], first=BACK)
-    assert backend.inits == [0, BACK]
+    back, inits = restarted_by_detection(frames, GONE, BACK, PART, PART_AFTER, detector)
+    assert inits == [0, BACK]
     assert all(e.state is TrackState.TRACKING for e in back)
     assert iou(back[0].box, PART_AFTER) > 0.9
