@@ -27,6 +27,7 @@ class TrackerSettings:
     reacquire_after_frames: int = 3  # low-confidence frames before a search may re-initialise
     reacquire_score: float = 0.75  # template match needed to re-initialise on a found box
     reacquire_margin: float = 0.3  # ... and by how much it must beat the backend's own box
+    reacquire_below_typical: float = 0.2  # ... and be at least the subject's typical likeness minus this
     adapt_confidence: float = 0.6  # the adaptive template learns only above this
     adapt_rate: float = 0.05
     lost_after_frames: int = 15  # consecutive low-confidence frames before declaring LOST
@@ -57,6 +58,8 @@ class SubjectTracker:
         self._size: tuple[float, float] = (0.0, 0.0)  # the subject's size when last seen confidently
         self._misses = 0
         self._frame_index = -1
+        self._typical_likeness = 0.0  # the subject's running pixel likeness on its confident frames ...
+        self._confident_frames = 0  # ... (their mean until there are 1 / adapt_rate of them)
 
     def init(self, frame: np.ndarray, box: Box, timestamp: float) -> TargetEstimate:
         """Start following ``box`` (x, y, w, h) in ``frame``; it may reach over the frame's edges
@@ -65,6 +68,7 @@ class SubjectTracker:
         height, width = frame.shape[:2]
         box = start_box(tuple(float(v) for v in box), width, height)
         self._appearance = AppearanceModel(frame, box)
+        self._typical_likeness, self._confident_frames = 0.0, 0
         self._restart(frame, box, timestamp)
         self._frame_index = 0
         return self._estimate(1.0, TrackState.TRACKING, timestamp)
@@ -82,10 +86,12 @@ class SubjectTracker:
         similarity = self._appearance.similarity(patch) if patch is not None else 0.0
         confidence = backend_score * similarity
         if box is not None and confidence >= s.track_confidence:
-            return self._accept(frame, box, patch, confidence, timestamp)
+            return self._accept(frame, box, patch, similarity, confidence, timestamp)
         self._misses += 1
         found = self._search(frame, predicted) if self._misses >= s.reacquire_after_frames else Match(predicted, 0.0)
-        if found.score >= s.reacquire_score and found.score >= similarity + s.reacquire_margin:
+        needed = max(s.reacquire_score, similarity + s.reacquire_margin,
+                     self._typical_likeness - s.reacquire_below_typical)
+        if found.score >= needed:
             self._restart(frame, found.box, timestamp)
             return self._estimate(found.score, TrackState.TRACKING, timestamp)
         if self._misses > s.lost_after_frames:
@@ -95,11 +101,14 @@ class SubjectTracker:
             self._kalman.correct(box, confidence)
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
-    def _accept(self, frame: np.ndarray, box: Box, patch: np.ndarray, confidence: float,
+    def _accept(self, frame: np.ndarray, box: Box, patch: np.ndarray, similarity: float, confidence: float,
                 timestamp: float) -> TargetEstimate:
         s = self.settings
         self._misses = 0
         if confidence >= s.adapt_confidence:
+            self._confident_frames += 1
+            rate = max(s.adapt_rate, 1.0 / self._confident_frames)
+            self._typical_likeness += rate * (similarity - self._typical_likeness)
             self._size = (box[2], box[3])  # not a box shrinking as the subject slides out of sight
             self._appearance.adapt(patch, s.adapt_rate)  # the patch the similarity was measured on
         if s.refine_blend > 0:
