@@ -15,7 +15,9 @@ from tracker.nanotrack import NanoTrackBackend, load_nanotrack_networks, nanotra
 
 
 class TrackingBackend(Protocol):
-    """Follows one box from frame to frame; knows nothing about loss or re-acquisition."""
+    """Follows one box from frame to frame; knows nothing about loss or re-acquisition. A backend
+    may also offer ``likeness(frame, box)``: a box's likeness to the subject in its own features over
+    their typical value, which a re-acquisition must then reach (``NanoTrackBackend``)."""
 
     name: str
 
@@ -40,6 +42,12 @@ class ConvertingBackend:
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
         return self._backend.update(self._convert(frame))
+
+    def likeness(self, frame: np.ndarray, box: Box) -> float:
+        """The wrapped backend's likeness of ``box`` to the subject, relative to its typical value
+        (1 for a backend that cannot score boxes)."""
+        score = getattr(self._backend, "likeness", None)
+        return score(self._convert(frame), box) if score is not None else 1.0
 
 
 class OpenCvBackend:

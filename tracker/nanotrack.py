@@ -10,7 +10,9 @@ The foreground score stays near 1 on background, so the backend's score is that 
 subject's likeness in the backbone's own features: the cosine similarity of the template's cells
 under the subject's box with the search features under the chosen box (cell 7.5 of the 16x16
 search features is the crop's centre, 3.5 of the 8x8 template's), relative to its running typical
-value. It reuses the features of the search already made: no extra network pass.
+value. It reuses the features of the search already made: no extra network pass. Before the
+subject tracker restarts the backend on a template match, ``likeness`` scores that box the same way
+(one backbone pass, only then).
 """
 from __future__ import annotations
 
@@ -50,11 +52,13 @@ class NanoTrackParams:
     calibration_limits: tuple[float, float] = (0.7, 1.4)
     # The score's likeness factor: the deep-feature likeness over its running typical value, which
     # follows frames at likeness_learn_above of it or more at likeness_rate (as dcf's response peak),
-    # so it does not sink to the background's level; at likeness_full of the typical value or more the
-    # factor is 1 (the subject's own frame-to-frame scatter; at 1.0 it cost AUC, docs/tracker.md).
+    # so it does not sink to the background's level. The factor ramps from 0 at likeness_zero of the
+    # typical value (background boxes there sat just over the confidence gate) to 1 at likeness_full
+    # of it or more (the subject's own frame-to-frame scatter; at 1.0 it cost AUC, docs/tracker.md).
     likeness_rate: float = 0.05
     likeness_learn_above: float = 0.6
     likeness_full: float = 0.75
+    likeness_zero: float = 0.5
 
 
 def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
@@ -295,10 +299,10 @@ class NanoTrackBackend:
         return np.clip(np.exp(p.calibration_strength * log_ratio), *p.calibration_limits)
 
     def _relative_likeness(self, likeness: float) -> float:
-        """The score's likeness factor, 0..1: ``likeness`` over its running typical value, divided by
-        ``likeness_full`` and capped at 1 (1 on the first frame). Only frames at ``likeness_learn_above``
-        of the typical value or more move it, as ``dcf`` does with its response peak, so it does not
-        sink to the background's level while the subject is gone."""
+        """The score's likeness factor, 0..1: ``likeness`` over its running typical value, ramped from
+        0 at ``likeness_zero`` to 1 at ``likeness_full`` (1 on the first frame). Only frames at
+        ``likeness_learn_above`` of the typical value or more move it, as ``dcf`` does with its response
+        peak, so it does not sink to the background's level while the subject is gone."""
         p = self.params
         if self._typical_likeness <= 0.0:
             self._typical_likeness = likeness
@@ -306,11 +310,25 @@ class NanoTrackBackend:
         if relative >= p.likeness_learn_above:
             rate = p.likeness_rate * relative
             self._typical_likeness = (1 - rate) * self._typical_likeness + rate * likeness
-        return min(relative / p.likeness_full, 1.0)
+        return float(np.clip((relative - p.likeness_zero) / (p.likeness_full - p.likeness_zero), 0.0, 1.0))
 
-    def _context_side(self) -> float:
-        """Side of the template crop: the box padded by ``context_amount`` (w + h), squared."""
-        w, h = self._size
+    def likeness(self, frame: np.ndarray, box: Box) -> float:
+        """``box``'s deep-feature likeness to the subject over its running typical value (1 while that
+        is unknown): one backbone pass on a template crop centred on ``box``, sized as at init."""
+        if self._typical_likeness <= 0.0:
+            return 1.0
+        x, y, w, h = (float(v) for v in box)
+        side = self._context_side((max(w, 1.0), max(h, 1.0)))
+        features = self._features(crop_square(frame, x + w / 2, y + h / 2, side, EXEMPLAR_SIZE, self._fill))
+        middle = (TEMPLATE_FEATURES - 1) / 2
+        rows, cols = self._subject_features.shape[1:]
+        cells = sample_cells(features[0], (middle, middle), (cols, rows))
+        return cosine_likeness(self._subject_features, cells) / self._typical_likeness
+
+    def _context_side(self, size: tuple[float, float] | None = None) -> float:
+        """Side of the template crop: the box (of ``size``, else the tracked one) padded by
+        ``context_amount`` (w + h), squared."""
+        w, h = self._size if size is None else size
         pad = self.params.context_amount * (w + h)
         return float(np.sqrt((w + pad) * (h + pad)))
 

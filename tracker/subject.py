@@ -28,6 +28,7 @@ class TrackerSettings:
     reacquire_score: float = 0.75  # template match needed to re-initialise on a found box
     reacquire_margin: float = 0.3  # ... and by how much it must beat the backend's own box
     reacquire_below_typical: float = 0.2  # ... and be at least the subject's typical likeness minus this
+    reacquire_deep_likeness: float = 0.6  # ... and the backend's own likeness ratio for it at least this
     adapt_confidence: float = 0.6  # the adaptive template learns only above this
     adapt_rate: float = 0.05
     lost_after_frames: int = 15  # consecutive low-confidence frames before declaring LOST
@@ -91,7 +92,7 @@ class SubjectTracker:
         found = self._search(frame, predicted) if self._misses >= s.reacquire_after_frames else Match(predicted, 0.0)
         needed = max(s.reacquire_score, similarity + s.reacquire_margin,
                      self._typical_likeness - s.reacquire_below_typical)
-        if found.score >= needed:
+        if found.score >= needed and self._backend_likes(frame, found.box):
             self._restart(frame, found.box, timestamp)
             return self._estimate(found.score, TrackState.TRACKING, timestamp)
         if self._misses > s.lost_after_frames:
@@ -100,6 +101,13 @@ class SubjectTracker:
         if box is not None:
             self._kalman.correct(box, confidence)
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
+
+    def _backend_likes(self, frame: np.ndarray, box: Box) -> bool:
+        """Whether the backend's own likeness of ``box`` to the subject (relative to its typical
+        value; backends that cannot score boxes say 1) reaches ``reacquire_deep_likeness``."""
+        bar = self.settings.reacquire_deep_likeness
+        score = getattr(self._backend, "likeness", None)
+        return bar <= 0.0 or score is None or score(frame, box) >= bar
 
     def _accept(self, frame: np.ndarray, box: Box, patch: np.ndarray, similarity: float, confidence: float,
                 timestamp: float) -> TargetEstimate:

@@ -279,3 +279,35 @@ def test_the_score_falls_where_the_subject_is_gone_though_the_foreground_score_s
     assert min(backend.update(subject)[1] for _ in range(3)) > 0.9
     assert max(backend.update(ground)[1] for _ in range(3)) < 0.5
     assert min(backend.update(subject)[1] for _ in range(3)) > 0.9  # the typical likeness did not sink
+
+
+def test_a_box_about_half_as_like_the_subject_as_usual_falls_under_the_gate(tmp_path):
+    """The likeness factor ramps from 0 at half the typical deep likeness (``likeness_zero``) to 1 at
+    ``likeness_full`` of it: a background box at ~0.52 of it (where NanoTrack's boxes on background
+    sat just over the 0.25 gate while the subject was hidden) scores under the gate, with a head
+    sure of the foreground; the subject itself keeps a full score."""
+    models = fake_onnx.write_nanotrack_files(tmp_path, fake_onnx.backbone_bytes(), fake_onnx.head_bytes(sure=True))
+    look, half = np.array([20.0, 40.0, 220.0]), np.array([150.0, 100.0, 70.0])
+    assert 0.5 < cosine_likeness(look, half) < 0.55  # the fake backbone's features are mean colours
+    subject = np.full((480, 640, 3), look, np.uint8)
+    ground = np.full((480, 640, 3), half, np.uint8)
+    backend = NanoTrackBackend(models, NanoTrackParams(velocity_gain=0.0))
+    backend.init(subject, (288.0, 208.0, 64.0, 64.0))
+    assert min(backend.update(subject)[1] for _ in range(3)) > 0.9
+    assert max(backend.update(ground)[1] for _ in range(3)) < 0.25
+
+
+def test_likeness_scores_a_box_against_the_subject_relative_to_its_typical_likeness(tmp_path):
+    """``likeness`` (used before a restart): ~1 for a box on the subject, its cosine with the
+    subject's look for a box on another colour; 1 before the typical likeness is known."""
+    models = fake_onnx.write_nanotrack_files(tmp_path, fake_onnx.backbone_bytes(), fake_onnx.head_bytes(sure=True))
+    look, other = np.array([20.0, 40.0, 220.0]), np.array([200.0, 60.0, 20.0])
+    subject = np.full((480, 640, 3), look, np.uint8)
+    ground = np.full((480, 640, 3), other, np.uint8)
+    backend = NanoTrackBackend(models, NanoTrackParams(velocity_gain=0.0))
+    box = (288.0, 208.0, 64.0, 64.0)
+    backend.init(subject, box)
+    assert backend.likeness(ground, box) == 1.0
+    backend.update(subject)
+    assert backend.likeness(subject, (100.0, 50.0, 80.0, 60.0)) == pytest.approx(1.0, abs=0.02)
+    assert backend.likeness(ground, box) == pytest.approx(cosine_likeness(look, other), abs=0.02)
