@@ -31,6 +31,7 @@ INSTANCE_SIZE = 255  # search crop side, pixels
 STRIDE = 16  # search-crop pixels per score-map cell
 SCORE_SIZE = 16  # score map side (the head only accepts a 16x16 search feature map)
 TEMPLATE_FEATURES = 8  # the backbone's feature map side for a template crop
+TEMPLATE_MIDDLE = ((TEMPLATE_FEATURES - 1) / 2, (TEMPLATE_FEATURES - 1) / 2)  # its centre, in cells (col, row)
 MIN_SIZE = 10.0  # smallest box side kept, pixels
 
 
@@ -203,6 +204,12 @@ def cosine_likeness(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.clip(np.vdot(a, b) / norm, 0.0, 1.0)) if norm > 0 else 0.0
 
 
+def likeness_at(subject: np.ndarray, features: np.ndarray, cell: tuple[float, float]) -> float:
+    """The subject's template cells (C, rows, cols) against ``features`` (C, H, W) sampled as many
+    cells around ``cell`` (col, row), 0..1."""
+    return cosine_likeness(subject, sample_cells(features, cell, (subject.shape[2], subject.shape[1])))
+
+
 def crop_square(frame: np.ndarray, cx: float, cy: float, side: float, out: int,
                 fill: tuple[float, float, float]) -> np.ndarray:
     """The square of ``side`` image pixels centred on (cx, cy), resampled to ``out`` x ``out``.
@@ -225,7 +232,7 @@ class Peak:
 
     def likeness(self, subject: np.ndarray) -> float:
         """The search features under the box against the subject's template cells (C, rows, cols), 0..1."""
-        return cosine_likeness(subject, sample_cells(self.features, self.cell, (subject.shape[2], subject.shape[1])))
+        return likeness_at(subject, self.features, self.cell)
 
 
 class NanoTrackBackend:
@@ -254,11 +261,10 @@ class NanoTrackBackend:
         self._velocity = np.zeros(2)
         self._fill = tuple(float(v) for v in cv2.mean(frame)[:3])
         side = self._context_side()
-        template = self._features(crop_square(frame, *self._center, side, EXEMPLAR_SIZE, self._fill))
+        template = self._template(frame, self._center, side)
         self._head.setInput(template, "input1")
         cells = np.clip(np.round(self._size * EXEMPLAR_SIZE / side / STRIDE), 1, TEMPLATE_FEATURES).astype(int)
-        middle = (TEMPLATE_FEATURES - 1) / 2
-        self._subject_features = sample_cells(template[0], (middle, middle), (int(cells[0]), int(cells[1])))
+        self._subject_features = sample_cells(template[0], TEMPLATE_MIDDLE, (int(cells[0]), int(cells[1])))
         self._typical_likeness = 0.0
         self._ready = True
         self._calibration = self._measure_size_calibration(frame)
@@ -318,12 +324,8 @@ class NanoTrackBackend:
         if self._typical_likeness <= 0.0:
             return 1.0
         x, y, w, h = (float(v) for v in box)
-        side = self._context_side((max(w, 1.0), max(h, 1.0)))
-        features = self._features(crop_square(frame, x + w / 2, y + h / 2, side, EXEMPLAR_SIZE, self._fill))
-        middle = (TEMPLATE_FEATURES - 1) / 2
-        rows, cols = self._subject_features.shape[1:]
-        cells = sample_cells(features[0], (middle, middle), (cols, rows))
-        return cosine_likeness(self._subject_features, cells) / self._typical_likeness
+        template = self._template(frame, (x + w / 2, y + h / 2), self._context_side((max(w, 1.0), max(h, 1.0))))
+        return likeness_at(self._subject_features, template[0], TEMPLATE_MIDDLE) / self._typical_likeness
 
     def _context_side(self, size: tuple[float, float] | None = None) -> float:
         """Side of the template crop: the box (of ``size``, else the tracked one) padded by
@@ -331,6 +333,10 @@ class NanoTrackBackend:
         w, h = self._size if size is None else size
         pad = self.params.context_amount * (w + h)
         return float(np.sqrt((w + pad) * (h + pad)))
+
+    def _template(self, frame: np.ndarray, center: tuple[float, float] | np.ndarray, side: float) -> np.ndarray:
+        """The backbone's features of the template crop of ``side`` image pixels centred on ``center``."""
+        return self._features(crop_square(frame, *center, side, EXEMPLAR_SIZE, self._fill))
 
     def _features(self, crop: np.ndarray) -> np.ndarray:
         if crop.ndim == 2:  # the networks take three channels
