@@ -160,8 +160,9 @@ STDOUT_FD, STDERR_FD = 1, 2
 
 
 def hold_on_devnull(fd: int) -> None:
-    """Open /dev/null on ``fd``, closed when the program started, so that no output file opened
-    later takes that number (and gets what is written to stdout or stderr, OpenCV's own included)."""
+    """Open /dev/null on ``fd``: one closed when the program started, so that no output file opened
+    later takes that number (and gets what is written to stdout or stderr, OpenCV's own included),
+    or one whose writes failed, so that nothing written later fails again."""
     null = os.open(os.devnull, os.O_WRONLY)
     if null != fd:
         os.dup2(null, fd)
@@ -204,4 +205,4 @@ class ClosedStdout(io.TextIOBase):
 
 def _drop_stdout() -> None:
     """Point stdout at /dev/null, so that Python's own flush at exit cannot fail a second time."""
-    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    hold_on_devnull(sys.stdout.fileno())
