@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from numbers import Real
+from numbers import Integral, Real
 
 
 class FieldError(ValueError):
@@ -35,13 +35,17 @@ def number(low: float = -math.inf, high: float = math.inf, *, above: bool = Fals
 
 
 def integer(low: int, high: int) -> Test:
-    """Integers from ``low`` to ``high``; no bools."""
-    return lambda value: isinstance(value, int) and not isinstance(value, bool) and low <= value <= high
+    """Integers (numpy's too) from ``low`` to ``high``; no bools."""
+    return lambda value: isinstance(value, Integral) and not isinstance(value, bool) and low <= value <= high
 
 
 def check(instance: object, rules: dict[str, tuple[str, Test]]) -> None:
-    """Raise ``FieldError`` for the first field of ``instance`` that fails its rule (field: (takes, test))."""
+    """Raise ``FieldError`` for the first field of ``instance`` that fails its rule (field: (takes, test));
+    numbers of other types (numpy's) that pass are stored as Python's ``int`` or ``float``, which the
+    message codec and the JSON status lines expect."""
     for field, (takes, test) in rules.items():
         value = getattr(instance, field)
         if not test(value):
             raise FieldError(type(instance).__name__, field, takes, value)
+        if isinstance(value, Real) and type(value) not in (int, float, bool):
+            object.__setattr__(instance, field, int(value) if isinstance(value, Integral) else float(value))

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 import pytest
 
 from gimbal.sim import Faults, SimConfig
@@ -41,3 +43,12 @@ def test_the_edges_are_taken() -> None:
     SimConfig(calibration_s=0.0, base_yaw_deg=-720.0, rx_id=0x7FF, tx_id=0, version=0xFFFFFFFF,
               push_rate_hz=1000.0, calibration_push_hz=1000.0)
     Faults(drop=1.0, delay_s=0.0, nack_code=0xFF, foreign_rate=20_000, silent=(5.0, INF))  # silent to the end
+
+
+def test_numpy_numbers_are_taken_and_answered(make_client) -> None:
+    """Values read from a numpy array (a config file, a sweep) pass the checks as Python's do."""
+    client, _ = make_client(SimConfig(version=np.uint32(0x01020304), device_id=np.int64(1), rx_id=np.int32(0x223),
+                                      tx_id=np.int16(0x222), push_rate_hz=np.float32(50.0)),
+                            Faults(nack_code=np.uint8(3), delay_s=np.float64(0.0)))
+    reply = client.version()
+    assert (reply.device_id, reply.version_text) == (1, "01.02.03.04")
