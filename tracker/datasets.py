@@ -58,7 +58,10 @@ def parse_groundtruth(path: Path) -> tuple[Box, ...]:
     and VOT write them). A UTF-8 byte-order mark and blank lines at the end are ignored; a blank line
     before the last box is an error, since skipping it would pair every later box with the wrong frame.
     """
-    lines = Path(path).read_text(encoding="utf-8-sig").splitlines()
+    try:
+        lines = Path(path).read_text(encoding="utf-8-sig").splitlines()
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file of boxes") from None
     while lines and not lines[-1].strip():
         lines.pop()
     if not lines:

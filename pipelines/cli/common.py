@@ -41,6 +41,16 @@ def existing_dir(text: str) -> Path:
     return path
 
 
+def existing_file(text: str) -> Path:
+    """An existing file (``--groundtruth``): an empty path or a folder is refused by name."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path")
+    path = Path(text)
+    if not path.is_file():
+        raise argparse.ArgumentTypeError(f"no such file: {text!r}")
+    return path
+
+
 def out_dir(text: str) -> Path:
     """An ``--out`` folder; an empty one is refused (it would mean the current folder), and so is
     the filesystem root (a run's files scattered among the system's folders)."""

@@ -5,10 +5,11 @@ import argparse
 import json
 import sys
 from collections.abc import Callable
+from pathlib import Path
 
 import cv2
 
-from pipelines.cli.common import CliError, existing_dir
+from pipelines.cli.common import CliError, existing_dir, existing_file
 from pipelines.progress import ProgressReporter
 from tracker.datasets import GROUNDTRUTH_NAMES, FrameReadError, Sequence, load_sequence
 from tracker.evaluation import SequenceResult, Trackable, first_box, run_sequence, summarize
@@ -24,6 +25,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "when nothing was timed: a one-frame sequence).",
         epilog="examples:\n  gimbaltrack eval ../shared/data/sequences/otb_girl ../shared/data/sequences/vot15_ball1\n"
         "  gimbaltrack eval samples/demo.mp4 --tracker csrt --json\n"
+        "  gimbaltrack eval ../shared/data/clips/clip_vot_bag_video/bag.avi "
+        "--groundtruth ../shared/data/sequences/vot_bag/groundtruth.txt\n"
         "  gimbaltrack eval ../shared/data/sequences/otb_girl --tracker nanotrack --model-dir ../shared/data/models\n\n"
         "exit status: 0 done; 2 bad input. Every sequence is checked before the first runs; a frame that\n"
         "  cannot be read (a damaged image, a truncated video) is found only on the way: that sequence\n"
@@ -31,6 +34,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("sequences", nargs="+", metavar="SEQ_DIR",
                         help="OTB/VOT sequence folder, image folder with groundtruth, or video with one beside it")
+    parser.add_argument("--groundtruth", type=existing_file, metavar="FILE",
+                        help="the ground truth of the one SEQ_DIR given, where it is not in its folder or beside "
+                        "its video (OTB x,y,w,h or VOT polygon lines, one per frame)")
     parser.add_argument("--tracker", default="default", metavar="NAME",
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
                         f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND})")
@@ -43,7 +49,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     cv2.setNumThreads(1)
-    sequences = [_load(path) for path in args.sequences]
+    if args.groundtruth is not None and len(args.sequences) > 1:
+        raise CliError(f"--groundtruth is for one sequence, not {len(args.sequences)}: give each its own run")
+    sequences = [_load(path, args.groundtruth) for path in args.sequences]
     results: list[SequenceResult] = []
     for sequence in sequences:
         try:
@@ -75,9 +83,9 @@ def _score(subject: Trackable, sequence: Sequence, skipped_note: bool) -> Sequen
     return None
 
 
-def _load(path: str) -> Sequence:
+def _load(path: str, groundtruth: Path | None = None) -> Sequence:
     try:
-        sequence = load_sequence(path)
+        sequence = load_sequence(path, groundtruth)
     except (ValueError, FileNotFoundError) as exc:
         raise CliError(str(exc)) from None
     if sequence.groundtruth is None:
@@ -86,7 +94,8 @@ def _load(path: str) -> Sequence:
             stem = sequence.video_path.stem
             names += [f"{stem}.txt", f"{stem}_groundtruth.txt"]
         where = "beside the video" if sequence.video_path is not None else "in the folder"
-        raise CliError(f"{path}: no ground truth ({', '.join(names[:-1])} or {names[-1]} {where})")
+        raise CliError(f"{path}: no ground truth ({', '.join(names[:-1])} or {names[-1]} {where}; "
+                       "or name its file with --groundtruth)")
     try:
         first_box(sequence)
     except ValueError as exc:

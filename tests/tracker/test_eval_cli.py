@@ -152,7 +152,8 @@ def test_a_video_without_groundtruth_names_every_file_accepted(tmp_path):
     captured = gimbaltrack(["eval", str(clip)])
     assert captured.returncode == 2
     assert captured.stderr == (f"gimbaltrack eval: error: {clip}: no ground truth (groundtruth_rect.txt, "
-                               "groundtruth.txt, clip.txt or clip_groundtruth.txt beside the video)\n")
+                               "groundtruth.txt, clip.txt or clip_groundtruth.txt beside the video; or name its file "
+                               "with --groundtruth)\n")
 
 
 def test_nanotrack_without_model_files_names_the_option(otb_dir):
@@ -195,3 +196,22 @@ def test_sigterm_exits_143_with_a_note(tmp_path):
                                      lambda process: process.stderr.readline().startswith("["))  # progress
     assert code == 143 and stdout == ""
     assert stderr.splitlines()[-1] == "gimbaltrack eval: terminated (SIGTERM)" and "Traceback" not in stderr
+
+
+def test_a_videos_groundtruth_can_be_named(tmp_path):
+    """A video whose ground truth lives elsewhere (the shared data's bag.avi and sequences/vot_bag)
+    scores as with the same file beside it; a second sequence, or a file that is not text, is refused."""
+    seq = render_sequence(frames=20, seed=3)
+    clip = write_clip(tmp_path / "clip.avi", seq.frames, 30.0, "MJPG")
+    truth = tmp_path / "elsewhere" / "groundtruth.txt"
+    truth.parent.mkdir()
+    truth.write_text("".join(",".join(f"{v:.1f}" for v in b) + "\n" for b in seq.boxes))
+    named = gimbaltrack(["eval", str(clip), "--groundtruth", str(truth), "--json"])
+    assert named.returncode == 0
+    (tmp_path / "clip.txt").write_text(truth.read_text())
+    beside = gimbaltrack(["eval", str(clip), "--json"])
+    scores = [[{k: row[k] for k in ("sequence", "frames", "prec20", "auc")} for row in map(json.loads, run.stdout.splitlines()[:1])]
+              for run in (named, beside)]
+    assert scores[0] == scores[1] and scores[0][0]["frames"] == 20
+    one_line_error(gimbaltrack(["eval", str(clip), str(clip), "--groundtruth", str(truth)]), "--groundtruth is for one sequence")
+    one_line_error(gimbaltrack(["eval", str(clip), "--groundtruth", str(clip)]), f"{clip}: not a text file of boxes")
