@@ -36,6 +36,8 @@ def existing_dir(text: str) -> Path:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path (use . for the current folder)")
     path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
     if not path.is_dir():
         raise argparse.ArgumentTypeError(f"no such folder: {text!r}")
     return path
@@ -46,6 +48,8 @@ def existing_file(text: str) -> Path:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path")
     path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
     if not path.is_file():
         raise argparse.ArgumentTypeError(f"no such file: {text!r}")
     return path
