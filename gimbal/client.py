@@ -258,7 +258,8 @@ class GimbalClient:
         stop asked for explicitly always goes out while the bus can carry it (on a bus this
         client does not own, one still open), since an extra stop costs a controller one tick and
         a missing one can leave the gimbal in SDK speed control. ``stats`` counts those that went
-        out (``stop_zero_sent``, ``stop_release_sent``).
+        out (``stop_zero_sent``, ``stop_release_sent``), answered or not: one the gimbal left
+        unanswered or refused is on the bus (and in the CAN log) all the same.
         """
         for message in stop_messages():
             name = "stop_zero_sent" if message.ctrl_byte & SPEED_TAKE_CONTROL else "stop_release_sent"
@@ -268,10 +269,12 @@ class GimbalClient:
                     self.request(message, retries=0)
                 else:
                     self.transport.send(self._encode(message)[1])
-                self.stats[name] += 1
             except (GimbalError, can.CanError, OSError) as exc:
                 log.warning("safety stop (%s): %s", "zero speed" if message.ctrl_byte & SPEED_TAKE_CONTROL
                             else "release control", exc)
+                if not isinstance(exc, (GimbalTimeoutError, ReturnCodeError)):
+                    continue  # not sent
+            self.stats[name] += 1
         self._speed_engaged = False
 
     @property
