@@ -67,7 +67,11 @@ class YuNetFaceDetector:
 
     def __init__(self, model_dir: str | Path | None, score_threshold: float = 0.6) -> None:
         model = find_model_file(model_dir, "yunet", "face_detection_yunet*.onnx", "YuNet face detector")
-        self._net = cv2.FaceDetectorYN.create(str(model), "", (320, 320), score_threshold)
+        try:  # a damaged file fails to load, another network at its first frame: both named here
+            self._net = cv2.FaceDetectorYN.create(str(model), "", (320, 320), score_threshold)
+            self._net.detect(np.zeros((320, 320, 3), np.uint8))
+        except cv2.error:
+            raise ValueError(f"YuNet face detector {model}: not a YuNet network (damaged or another file?)") from None
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
         if frame.size == 0:
