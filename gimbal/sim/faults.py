@@ -51,7 +51,7 @@ RULES = {
     "direction": (f"one of {', '.join(DIRECTIONS)}", lambda v: v in DIRECTIONS),
     "delay_s": ("a finite delay, 0 or more", number(0)),
     "nack": _FRACTION,
-    "nack_code": ("a byte, 0 to 0xFF", integer(0, 0xFF)),
+    "nack_code": ("a return code, 1 to 0xFF (0 means executed)", integer(1, 0xFF)),
     "silent": ("a window START:END in seconds, 0 <= START <= END (END may be inf)", _window),
     "legacy": _FRACTION,
     "foreign_rate": (f"a rate from 0 to {MAX_FOREIGN_RATE_HZ} Hz (a 1 Mbit/s bus carries less)",

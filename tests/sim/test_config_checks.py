@@ -31,7 +31,7 @@ def test_sim_config_refuses(field: str, value: object) -> None:
 
 @pytest.mark.parametrize("field, value", [
     ("delay_s", NAN), ("delay_s", INF), ("delay_s", -0.001), ("drop", NAN), ("nack", 1.5),
-    ("legacy", -0.1), ("foreign_rate", NAN), ("nack_code", 0x100), ("direction", "up"),
+    ("legacy", -0.1), ("foreign_rate", NAN), ("nack_code", 0x100), ("nack_code", 0), ("direction", "up"),
     ("silent", (NAN, 1.0)), ("silent", (1.0, NAN)), ("silent", (INF, INF)), ("silent", (3.0, 1.0)),
 ])
 def test_faults_refuse(field: str, value: object) -> None:

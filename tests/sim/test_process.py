@@ -133,7 +133,8 @@ PUSH_RATE = "--push-rate takes a rate above 0 Hz, at most 1000 Hz (a push takes 
     (["--push-rate", "inf"], f"{PUSH_RATE}, not inf"),
     (["--calibration-time", "-1"], "--calibration-time takes a finite time, 0 s or more, not -1"),
     (["--status-interval", "nan"], "--status-interval takes a finite interval, 0 s or more, not nan"),
-    (["--nack-code", "999"], "--nack-code takes a byte, 0 to 0xFF, not 999"),
+    (["--nack-code", "999"], "--nack-code takes a return code, 1 to 0xFF (0 means executed), not 999"),
+    (["--nack-code", "0"], "--nack-code takes a return code, 1 to 0xFF (0 means executed), not 0"),
     # the range checks are SimConfig's and Faults', in the options' words
     (["--silent", "3:1"], "--silent takes a window START:END in seconds, 0 <= START <= END (END may be inf), not 3:1"),
     (["--silent", "inf:inf", "--duration", "0.2"], "--silent takes a window START:END"),
