@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import queue
 import sys
 import time
@@ -33,6 +32,7 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
                                         GetUserParams, SetUserParams, Tlv, autotune,
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
+from pipelines.cli.app import hold_on_devnull
 from pipelines.cli.bus import open_host_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds, suppress_defaults
 
@@ -42,6 +42,7 @@ STIFFNESS = ("pitch", "roll", "yaw")
 CAMERA_ACTIONS = {code.name.lower().replace("_", "-"): code for code in CameraActionCode}
 OK: Result = {"ok": True}
 STREAM_HZ = 20.0  # joystick and dial pushes are repeated at this rate for --duration
+WATCH_STALL_S = 1.0  # watch says so once when no push came for this long (gimbals push at ~50 Hz)
 
 
 @dataclass
@@ -265,6 +266,7 @@ def _watch(client: GimbalClient, args: argparse.Namespace) -> None:
     if not args.no_enable:
         client.set_push(True)
     end = None if args.duration is None else start + args.duration
+    pushes, last, stalled = 0, start, False
     try:
         while end is None or time.monotonic() < end:
             try:
@@ -272,15 +274,28 @@ def _watch(client: GimbalClient, args: argparse.Namespace) -> None:
             except queue.Empty:
                 if not client.alive:
                     raise CliError("the CAN bus went away", exit_code=1) from None
+                if not stalled and time.monotonic() - last > WATCH_STALL_S:  # said once per silence
+                    print(f"gimbaltrack gimbal: no push for {WATCH_STALL_S:g} s{_no_push_hint(args)}",
+                          file=sys.stderr, flush=True)
+                    stalled = True
                 continue
+            pushes, last, stalled = pushes + 1, t, False
             described = describe_push(message, t - start)
             print(json.dumps(described) if args.json else render(described).replace("\n", "  "),
                   flush=True)
     except KeyboardInterrupt:
-        pass
+        return None
     except BrokenPipeError:  # e.g. piped into head: stop quietly
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        hold_on_devnull(sys.stdout.fileno())
+        return None
+    if not pushes:
+        raise CliError(f"no push arrived in {args.duration:g} s{_no_push_hint(args)}", exit_code=1)
     return None
+
+
+def _no_push_hint(args: argparse.Namespace) -> str:
+    """Why a gimbal may not push, for the notes of ``watch``."""
+    return " (--no-enable: its push may be off)" if args.no_enable else " (is the gimbal on, and its push on?)"
 
 
 def _version_args(p: argparse.ArgumentParser) -> None:

@@ -258,6 +258,26 @@ def test_watch_names_the_calibration_state(channel: str, peer: ScriptedPeer,
     assert (status["state"], status["progress"]) == ("running", 40)
 
 
+def test_watch_says_when_the_pushes_stop_and_fails_when_none_came(
+        channel: str, peer: ScriptedPeer, capsys: pytest.CaptureFixture[str]) -> None:
+    """A gimbal that stops pushing (switched off, push turned off elsewhere) once left watch silent,
+    and a run in which nothing ever arrived exited 0."""
+    def push_once_then_reply(message: Message) -> Message:
+        peer.push(ParameterPush(0x01, 32, 48, 64))
+        return PushControlReply()
+
+    peer.answer(PushControl, push_once_then_reply)
+    assert gimbal(channel, "watch", "--duration", "1.4", "--json") == 0
+    captured = capsys.readouterr()
+    assert len(captured.out.splitlines()) == 1
+    assert captured.err == "gimbaltrack gimbal: no push for 1 s (is the gimbal on, and its push on?)\n"
+    peer.answer(PushControl)
+    assert gimbal(channel, "watch", "--duration", "0.3", "--json") == 1
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.splitlines() == [
+        "gimbaltrack gimbal: error: no push arrived in 0.3 s (is the gimbal on, and its push on?)"]
+
+
 def test_the_range_error_in_the_docs_is_what_the_cli_prints(capsys: pytest.CaptureFixture[str]) -> None:
     doc = (Path(__file__).parents[2] / "docs" / "gimbal-cli.md").read_text(encoding="utf-8")
     command = "$ gimbaltrack gimbal move --yaw 200 --print-packet\n"
