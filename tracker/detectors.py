@@ -16,7 +16,7 @@ import numpy as np
 
 from tracker import camera_motion
 from tracker.boxes import Box
-from tracker.frames import as_bgr, as_bgr_or_grey, as_grey
+from tracker.frames import as_bgr, as_bgr_or_grey, as_grey, check_frame
 from tracker.model_files import find_model_file
 
 DETECTOR_KINDS = ("face", "person", "motion")
@@ -54,7 +54,7 @@ class HaarFaceDetector:
             raise ValueError(f"cannot load Haar cascade {path}")
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
-        if frame.size == 0:
+        if check_frame(frame).size == 0:
             return []
         grey = cv2.equalizeHist(as_grey(frame))
         boxes, hits = self._cascade.detectMultiScale2(grey, scaleFactor=1.1, minNeighbors=4, minSize=(20, 20))
@@ -74,7 +74,7 @@ class YuNetFaceDetector:
             raise ValueError(f"YuNet face detector {model}: not a YuNet network (damaged or another file?)") from None
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
-        if frame.size == 0:
+        if check_frame(frame).size == 0:
             return []
         height, width = frame.shape[:2]
         self._net.setInputSize((width, height))
@@ -98,7 +98,7 @@ class HogPersonDetector:
         self._max_side = max_side
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
-        if not self._fits_window(frame):
+        if not self._fits_window(check_frame(frame)):
             return []
         scale = min(1.0, self._max_side / max(frame.shape[:2]))
         image = cv2.resize(frame, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA) if scale < 1 else frame
@@ -150,7 +150,7 @@ class MotionDetector:
         self._background: _Background | None = None
 
     def detect(self, frame: np.ndarray) -> list[Detection]:
-        if frame.size == 0:
+        if check_frame(frame).size == 0:
             return []
         grey = _work_grey(frame)
         if self._history and self._history[-1].shape != grey.shape:
