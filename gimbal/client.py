@@ -1,8 +1,8 @@
 """The host side of the DJI R SDK over CAN: requests and replies, pushes, and the safety stop.
 
-Angles are degrees and speeds °/s in this API; they are converted to the wire's 0.1 units by
-rounding to the nearest unit and range-checked by the messages (``RangeError``) before anything
-is sent.
+Angles are degrees and speeds °/s in this API, any real numbers (numpy's too; not bools); they
+are converted to the wire's 0.1 units by rounding to the nearest unit and range-checked by the
+messages (``RangeError``, as is anything not a finite number) before anything is sent.
 
 Replies are matched to requests by SEQ when the gimbal echoes it, otherwise by CmdSet/CmdID
 (latest layout) or to the oldest outstanding request (legacy layout, which has no CmdSet/CmdID).

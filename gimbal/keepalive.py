@@ -10,7 +10,6 @@ next tick, which keeps the capture-to-command latency low; the schedule restarts
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
 from collections import Counter
@@ -20,8 +19,8 @@ from dataclasses import dataclass
 import can
 
 from gimbal.client import DEFAULT_MAX_AGE_S, SPEED_HOLD, GimbalClient, PendingReply
-from gimbal.errors import BusError, GimbalError, RangeError, SendError
-from gimbal.messages.motion import SpeedControl, to_raw
+from gimbal.errors import BusError, GimbalError, SendError
+from gimbal.messages.motion import SpeedControl, finite_number, to_raw
 
 log = logging.getLogger(__name__)
 
@@ -43,9 +42,7 @@ class _Setpoint:
 
 
 def _clamped_raw(value: float, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise RangeError(f"{name}={value!r} is not a finite number")
-    return to_raw(max(-MAX_SPEED_DPS, min(MAX_SPEED_DPS, value)), name)
+    return to_raw(max(-MAX_SPEED_DPS, min(MAX_SPEED_DPS, finite_number(value, name))), name)
 
 
 class SpeedStreamer:
@@ -90,14 +87,16 @@ class SpeedStreamer:
     def set(self, yaw_dps: float, pitch_dps: float, roll_dps: float = 0.0,
             stamp: float | None = None) -> None:
         """New setpoint in °/s, clamped to ±360. ``stamp`` is the capture time of the frame it
-        came from (same clock; default now), for ``latencies()``."""
+        came from (same clock; default now), for ``latencies()``. Speeds and stamp may be any real
+        numbers (numpy's too); anything else, or one not finite, is a ``RangeError``."""
         if self.error is not None:
             raise BusError(f"speed streaming stopped: {self.error}") from self.error
         if self._stopped:
             raise GimbalError("the speed streamer is stopped")
         now = self._clock()
         setpoint = _Setpoint(_clamped_raw(yaw_dps, "yaw_dps"), _clamped_raw(roll_dps, "roll_dps"),
-                             _clamped_raw(pitch_dps, "pitch_dps"), now, now if stamp is None else stamp)
+                             _clamped_raw(pitch_dps, "pitch_dps"), now,
+                             now if stamp is None else finite_number(stamp, "stamp"))
         with self._lock:
             self._setpoint = setpoint
         self._wake.set()

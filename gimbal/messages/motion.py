@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -34,11 +35,18 @@ POSITION_INVALID = {"yaw": POSITION_YAW_INVALID, "roll": POSITION_ROLL_INVALID,
                     "pitch": POSITION_PITCH_INVALID}  # ctrl_byte bit that leaves the axis alone
 
 
+def finite_number(value: float, name: str) -> float:
+    """``value`` as a float: any real number but a bool (numpy's too); ``RangeError`` otherwise."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise RangeError(f"{name}={value!r} is not a number")
+    if not math.isfinite(value):
+        raise RangeError(f"{name}={value!r} is not a finite number")
+    return float(value)
+
+
 def to_raw(value: float, name: str) -> int:
     """Degrees (or °/s, or s) to the wire's 0.1 units, rounded to the nearest unit."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise RangeError(f"{name}={value!r} is not a finite number")
-    return round(value * 10)
+    return round(finite_number(value, name) * 10)
 
 
 def from_raw(raw: int) -> float:
