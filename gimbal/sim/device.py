@@ -56,7 +56,9 @@ class SimulatedGimbal:
         self._threads: list[threading.Thread] = []
 
     def start(self) -> SimulatedGimbal:
-        """Start answering; returns self."""
+        """Start answering; returns self. Once stopped it cannot be started again."""
+        if self._stop.is_set():
+            raise RuntimeError("a stopped simulated gimbal cannot be started again; make a new one")
         if self._threads:
             raise RuntimeError("simulated gimbal already started")
         self._started_at = self.clock()
