@@ -60,5 +60,5 @@ def _annotated(predicted: Sequence[Box], truth: Sequence[Box]) -> tuple[list[Box
 
 
 def _check_lengths(predicted: Sequence[Box], truth: Sequence[Box]) -> None:
-    if len(predicted) != len(truth) or not truth:
+    if len(predicted) != len(truth) or len(truth) == 0:
         raise ValueError(f"need equal, non-zero box counts (got {len(predicted)} and {len(truth)})")
