@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 
 # A 24 mm lens on a full-frame (36 mm wide) sensor: hfov = 2 atan(18 / 24) ~ 73.74 deg.
 DEFAULT_FOCAL_MM = 24.0
@@ -19,8 +20,9 @@ class CameraModel:
 
     def __init__(self, width: int, height: int, hfov_deg: float | None = None,
                  focal_px: float | None = None) -> None:
-        if width <= 0 or height <= 0:
-            raise ValueError(f"image size must be positive, got {width}x{height}")
+        if not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in (width, height)) \
+                or width <= 0 or height <= 0:
+            raise ValueError(f"image size must be positive whole pixels, got {width!r}x{height!r}")
         if hfov_deg is not None and focal_px is not None:
             raise ValueError("give hfov_deg or focal_px, not both")
         if focal_px is None:
@@ -28,8 +30,8 @@ class CameraModel:
             if not 0.0 < hfov < 180.0:
                 raise ValueError(f"hfov_deg must be in (0, 180), got {hfov}")
             focal_px = width / 2.0 / math.tan(math.radians(hfov) / 2.0)
-        if focal_px <= 0:
-            raise ValueError(f"focal_px must be positive, got {focal_px}")
+        if not focal_px > 0 or not math.isfinite(focal_px):
+            raise ValueError(f"focal_px must be positive and finite, got {focal_px}")
         self.width = int(width)
         self.height = int(height)
         self.focal_px = float(focal_px)

@@ -42,6 +42,10 @@ class ControlConfig:
     setpoint_max_age_s: float = DEFAULT_MAX_AGE_S  # the keep-alive streams zero once a setpoint is this old
 
     def __post_init__(self) -> None:
+        for name in self.__dataclass_fields__:
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
+                raise ValueError(f"ControlConfig.{name} must be a number, not {value!r}")
         if not 0.0 < self.max_speed_dps <= PROTOCOL_MAX_SPEED_DPS:
             raise ValueError(f"max_speed_dps must be in (0, {PROTOCOL_MAX_SPEED_DPS:g}]")
         if (self.max_accel_dps2 <= 0 or self.hold_s < 0 or self.ramp_s <= 0 or self.first_step_s <= 0
@@ -82,6 +86,12 @@ class Controller(Protocol):
                now: float) -> RateCommand: ...
 
     def reset(self) -> None: ...
+
+
+def _check_now(last_now: float | None, now: float) -> None:
+    """``ValueError`` unless ``now`` is finite and not before the previous update's (one monotonic clock)."""
+    if not math.isfinite(now) or last_now is not None and now < last_now:
+        raise ValueError(f"now={now!r} must be a finite time, not before the previous update's {last_now!r}")
 
 
 def _time_step(config: ControlConfig, last_now: float | None, now: float) -> tuple[float, bool]:
@@ -230,6 +240,7 @@ class RateController:
         was ever given, taken as (0, 0) at each capture (the camera's frame).
         """
         c = self.config
+        _check_now(self._last_now, now)
         dt, from_rest = _time_step(c, self._last_now, now)
         self._last_now = now
         if from_rest:
@@ -352,6 +363,7 @@ class ProportionalController:
 
     def update(self, estimate: TargetEstimate | None, attitude: tuple[float, float] | None,
                now: float) -> RateCommand:
+        _check_now(self._last_now, now)
         if self._last_now is None:  # as public drivers do: the first frame only starts the clock
             dt = 0.0
         else:
