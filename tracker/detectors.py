@@ -17,7 +17,7 @@ import numpy as np
 from tracker import camera_motion
 from tracker.boxes import Box
 from tracker.frames import as_bgr, as_bgr_or_grey, as_grey, check_frame
-from tracker.model_files import find_model_file
+from tracker.model_files import checked_model_dir, find_model_file
 
 DETECTOR_KINDS = ("face", "person", "motion")
 HAAR_FACE = "haarcascade_frontalface_default.xml"
@@ -325,7 +325,9 @@ def _kernel(shape: tuple[int, ...]) -> np.ndarray:
 
 
 def make_detector(kind: str, model_dir: str | Path | None = None) -> Detector:
-    """A detector by kind: ``face`` (YuNet when ``model_dir`` holds its file, else Haar), ``person`` or ``motion``."""
+    """A detector by kind: ``face`` (YuNet when ``model_dir`` holds its file, else Haar), ``person`` or
+    ``motion``; a ``model_dir`` that is no folder is a ``FileNotFoundError``."""
+    model_dir = checked_model_dir(model_dir)
     if kind == "face":
         return _face_detector(model_dir)
     if kind == "person":

@@ -17,3 +17,14 @@ def find_model_file(model_dir: str | Path | None, subdir: str, pattern: str, wha
         if matches:
             return matches[0]
     raise FileNotFoundError(f"{what}: no {pattern} in {root} or {root / subdir}")
+
+
+def checked_model_dir(model_dir: str | Path | None) -> Path | None:
+    """``model_dir`` as a ``Path`` (``None`` as it is); ``FileNotFoundError`` when it is no folder,
+    so a mistyped path is not quietly taken for a folder without models."""
+    if model_dir is None:
+        return None
+    path = Path(model_dir)
+    if not path.is_dir():
+        raise FileNotFoundError(f"model directory {str(model_dir)!r} is not a folder")
+    return path

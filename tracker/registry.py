@@ -5,6 +5,7 @@ from pathlib import Path
 
 from tracker.backends import BACKEND_NAMES, make_backend
 from tracker.detectors import Detector
+from tracker.model_files import checked_model_dir
 from tracker.nanotrack import nanotrack_model_files
 from tracker.subject import SubjectTracker, TrackerSettings
 
@@ -24,8 +25,10 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
     """A subject tracker by name; ``detector``, if given, helps it find a lost subject again.
 
     ``default`` picks NanoTrack when ``model_dir`` holds its files, else the correlation filter.
-    Unknown names raise ``ValueError``; missing model files raise ``FileNotFoundError``.
+    Unknown names raise ``ValueError``; missing model files, or a ``model_dir`` that is no folder,
+    raise ``FileNotFoundError``.
     """
+    model_dir = checked_model_dir(model_dir)
     if name == "default":
         name = DEFAULT_WITH_MODELS if model_dir is not None and _has_nanotrack(model_dir) else DEFAULT_BACKEND
     if name not in BACKEND_NAMES:
