@@ -1,6 +1,7 @@
 """Frame sources: ``open_source(spec)`` for a video file, an image folder, a camera or a stream URL."""
 from __future__ import annotations
 
+import os
 import re
 import time
 from collections.abc import Callable
@@ -15,12 +16,13 @@ __all__ = ["Frame", "FrameSource", "SourceError", "open_source"]
 _URL = re.compile(r"^[a-z][a-z0-9+.-]*://", re.IGNORECASE)
 
 
-def open_source(spec: str, realtime: bool = False, *, fps: float | None = None,
+def open_source(spec: str | os.PathLike[str] | int, realtime: bool = False, *, fps: float | None = None,
                 stall_timeout: float = DEFAULT_STALL_TIMEOUT,
                 open_timeout: float = DEFAULT_OPEN_TIMEOUT,
                 clock: Callable[[], float] = time.monotonic,
                 sleep: Callable[[float], None] = time.sleep) -> FrameSource:
-    """Open ``spec``: a camera index ("0"), a stream URL, an image folder or a video file.
+    """Open ``spec``: a camera index ("0" or 0), a stream URL, an image folder or a video file
+    (a ``str`` or a path object); any other type is a ``SourceError``.
 
     Files are read as fast as pulled (timestamps ``index / fps``) or, with ``realtime``, paced at
     their frame rate (timestamps are ``clock`` readings). ``fps`` overrides or supplies a file's rate
@@ -28,6 +30,12 @@ def open_source(spec: str, realtime: bool = False, *, fps: float | None = None,
     and ``clock``: their timestamps are ``time.monotonic()`` at grab, and a live source that delivers
     nothing for ``stall_timeout`` s raises ``SourceError("stream stalled ...")``.
     """
+    if isinstance(spec, int) and not isinstance(spec, bool):
+        spec = str(spec)
+    elif isinstance(spec, os.PathLike):
+        spec = os.fspath(spec)
+    if not isinstance(spec, str):
+        raise SourceError(f"a source is a path, camera index or stream URL, not {spec!r}")
     if not spec.strip():  # Path("") is the current folder: nobody means that by an empty argument
         raise SourceError("an empty source: give a video file, image folder (. for the current one), "
                           "camera index or stream URL")
