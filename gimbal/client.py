@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import atexit
 import logging
+import numbers
 import threading
 import time
 from collections import Counter, deque
@@ -131,6 +132,16 @@ def lookup(table: dict[str, int], value: str | int, what: str) -> int:
     raise RangeError(f"{what} {value!r} is not one of {', '.join(table)}")
 
 
+def _checked_wait(timeout: float, retries: int) -> tuple[float, int]:
+    """A reply timeout (s, above 0, at most ``MAX_TIMEOUT``) and retry count (an int, 0 or more) as
+    float and int; ``ValueError`` naming what is wrong otherwise."""
+    if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real) or not 0 < timeout <= MAX_TIMEOUT:
+        raise ValueError(f"timeout must be above 0 and at most {MAX_TIMEOUT:.0f} s, not {timeout!r}")
+    if isinstance(retries, bool) or not isinstance(retries, numbers.Integral) or retries < 0:
+        raise ValueError(f"retries must be a whole number, 0 or more, not {retries!r}")
+    return float(timeout), int(retries)
+
+
 class PendingReply:
     """A command on the bus waiting for its reply; ``raw`` is its packet as sent (and resent)."""
 
@@ -173,8 +184,7 @@ class GimbalClient:
     def __init__(self, bus: can.BusABC | None = None, *, tx_id: int = HOST_TX_ID,
                  rx_id: int = HOST_RX_ID, timeout: float = 0.1, retries: int = 2,
                  **bus_kwargs: Any) -> None:
-        if not 0 < timeout <= MAX_TIMEOUT or retries < 0:
-            raise ValueError(f"timeout must be above 0 and at most {MAX_TIMEOUT:.0f} s, and retries >= 0")
+        timeout, retries = _checked_wait(timeout, retries)
         self._owns_bus = bus is None
         if bus is None:
             try:
@@ -489,8 +499,8 @@ class GimbalClient:
         if threading.current_thread() is self._rx_thread:
             raise GimbalError(f"{message.NAME}: a push callback cannot wait for a reply (it runs on "
                               "the thread that receives them); hand the work to another thread")
-        timeout = self.timeout if timeout is None else timeout
-        retries = self.retries if retries is None else retries
+        timeout, retries = _checked_wait(self.timeout if timeout is None else timeout,
+                                         self.retries if retries is None else retries)
         waiter = self.submit(message, cmd_type=REPLY_OPTIONAL if optional else None)
         try:
             for attempt in range(retries + 1):
@@ -547,6 +557,8 @@ class GimbalClient:
         and it cannot make requests (``GimbalError``). ``sys.exit()`` in it cannot end the program
         from that thread: it ends the receive thread, which stops the gimbal as a lost bus does,
         and later calls raise ``BusError`` naming the callback. Returns an unsubscribe function."""
+        if not callable(callback):
+            raise TypeError(f"a push callback must be callable, not {callback!r}")
         return self.pushes.subscribe(cls, callback)
 
     def latest(self, cls: type[Message]) -> tuple[Message, float] | None:
@@ -555,7 +567,10 @@ class GimbalClient:
 
     def wait_for_push(self, cls: type[Message], timeout: float) -> tuple[Message, float]:
         """The next ``cls`` push; ``GimbalTimeoutError`` after ``timeout`` s, the client's error at
-        once if it is closed or loses the bus meanwhile."""
+        once if it is closed or loses the bus meanwhile. ``timeout`` must be a number, 0 to
+        ``MAX_TIMEOUT`` s (``ValueError``)."""
+        if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real) or not 0 <= timeout <= MAX_TIMEOUT:
+            raise ValueError(f"a push timeout must be 0 to {MAX_TIMEOUT:.0f} s, not {timeout!r}")
         self._check_alive()
         return self.pushes.wait(cls, timeout)
 
