@@ -35,9 +35,13 @@ def iou(a: Box, b: Box) -> float:
 def start_box(box: Box, width: int, height: int, min_size: float = 4.0) -> Box:
     """A subject's first box as given, grown about its centre to at least ``min_size`` a side.
     It may reach over the frame's edges (so may the subject: moving it inside would start the
-    tracker on an offset patch); raises ``ValueError`` when it is not finite or misses the frame."""
+    tracker on an offset patch); raises ``ValueError`` when it is not finite, has no width or
+    height, or misses the frame."""
     if not all(math.isfinite(v) for v in box):
         raise ValueError(f"the start box {box} is not finite")
+    if box[2] <= 0 or box[3] <= 0:
+        raise ValueError(f"the start box {tuple(round(v, 1) for v in box)} needs a width and height above 0 "
+                         "(x, y, w, h)")
     cx, cy = center(box)
     w, h = max(box[2], min_size), max(box[3], min_size)
     x, y = cx - w / 2.0, cy - h / 2.0

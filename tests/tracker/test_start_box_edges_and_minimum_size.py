@@ -1,6 +1,6 @@
 """The subject's first box (``start_box``, used by ``SubjectTracker.init``): kept as given while it
-overlaps the frame by any amount, refused once it only touches an edge from outside or is not
-finite, and grown about its centre to 4 px a side when smaller."""
+overlaps the frame by any amount, refused once it only touches an edge from outside, is not
+finite or has no width or height, and grown about its centre to 4 px a side when smaller."""
 from __future__ import annotations
 
 import pytest
@@ -31,3 +31,10 @@ def test_a_box_that_is_not_finite_is_refused(box: Box) -> None:
 
 def test_a_tiny_box_grows_about_its_centre_to_the_minimum_size() -> None:
     assert start_box((100.0, 50.0, 1.0, 6.0), WIDTH, HEIGHT) == (98.5, 50.0, 4.0, 6.0)
+
+
+@pytest.mark.parametrize("box", [(100.0, 50.0, -20.0, 20.0), (100.0, 50.0, 20.0, 0.0)])
+def test_a_box_without_width_or_height_is_refused(box: Box) -> None:
+    """Once grown silently into a 4 px box (a swapped corner, x2 < x1, gave a tracker on nothing)."""
+    with pytest.raises(ValueError, match="needs a width and height above 0"):
+        start_box(box, WIDTH, HEIGHT)
