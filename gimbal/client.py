@@ -36,6 +36,7 @@ from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError,
 from gimbal.framer import Dropped
 from gimbal.messages import (Message, PayloadError, Reply, decode_message, is_device_push,
                              message_packet, reply_fits, reply_key)
+from gimbal.messages.base import is_flag
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, FocusPositionReply,
@@ -105,10 +106,18 @@ def position_message(yaw: float = 0.0, roll: float = 0.0, pitch: float = 0.0, *,
     return PositionControl(raw["yaw"], raw["roll"], raw["pitch"], ctrl, to_raw(time_s, "time"))
 
 
+def flag(value: bool, name: str) -> bool:
+    """``value`` as a bool when it is True or False (numpy's too); ``TypeError`` for anything else,
+    such as the string "no", which Python would take as true."""
+    if not is_flag(value):
+        raise TypeError(f"{name} must be True or False, not {value!r}")
+    return bool(value)
+
+
 def speed_message(yaw: float, pitch: float, roll: float = 0.0, *,
                   take_control: bool = True) -> SpeedControl:
     """Speed control in °/s (±360); bit 7 of ctrl_byte takes (or releases) control."""
-    ctrl = SPEED_HOLD if take_control else SPEED_RELEASE
+    ctrl = SPEED_HOLD if flag(take_control, "take_control") else SPEED_RELEASE
     return SpeedControl(to_raw(yaw, "yaw speed"), to_raw(roll, "roll speed"),
                         to_raw(pitch, "pitch speed"), ctrl)
 
@@ -627,7 +636,7 @@ class GimbalClient:
 
     def set_push(self, enabled: bool) -> None:
         """Enable or disable the parameter push (ParameterPush)."""
-        self.request(PushControl(PUSH_ENABLE if enabled else PUSH_DISABLE))
+        self.request(PushControl(PUSH_ENABLE if flag(enabled, "enabled") else PUSH_DISABLE))
 
     def version(self, device_id: int = DEVICE_ID_R_SDK) -> VersionReply:
         """A module's version (``reply.version_text`` reads AA.BB.CC.DD)."""
@@ -675,7 +684,7 @@ class GimbalClient:
     def auto_calibration(self, start: bool = True, type: int = 1) -> None:  # noqa: A002
         """Start or stop auto-tuning (type 1 = single pose, the document's advice). The document
         shows no reply, so it is sent reply-optional and silence is accepted."""
-        self.request(AutoCalibration((autotune(start, type),)), retries=0, optional=True)
+        self.request(AutoCalibration((autotune(flag(start, "start"), type),)), retries=0, optional=True)
 
     def activetrack_toggle(self) -> None:
         """Toggle ActiveTrack; reply-optional like ``auto_calibration``, never retried."""

@@ -6,6 +6,8 @@ import math
 from collections.abc import Callable
 from numbers import Integral, Real
 
+from gimbal.messages.base import is_flag
+
 
 class FieldError(ValueError):
     """``owner.field`` (e.g. ``Faults.delay_s``) takes ``takes`` (words without the field's unit
@@ -41,11 +43,16 @@ def integer(low: int, high: int) -> Test:
 
 def check(instance: object, rules: dict[str, tuple[str, Test]]) -> None:
     """Raise ``FieldError`` for the first field of ``instance`` that fails its rule (field: (takes, test));
-    numbers of other types (numpy's) that pass are stored as Python's ``int`` or ``float``, which the
-    message codec and the JSON status lines expect."""
+    bools and numbers of other types (numpy's) that pass are stored as Python's, which the message
+    codec and the JSON status lines expect."""
     for field, (takes, test) in rules.items():
         value = getattr(instance, field)
         if not test(value):
             raise FieldError(type(instance).__name__, field, takes, value)
-        if isinstance(value, Real) and type(value) not in (int, float, bool):
-            object.__setattr__(instance, field, int(value) if isinstance(value, Integral) else float(value))
+        if type(value) not in (int, float, bool) and (is_flag(value) or isinstance(value, Real)):
+            object.__setattr__(instance, field, _plain(value))
+
+
+def _plain(value: object) -> bool | int | float:
+    """A numpy bool or number as Python's."""
+    return bool(value) if is_flag(value) else int(value) if isinstance(value, Integral) else float(value)

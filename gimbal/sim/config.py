@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from gimbal.messages.telemetry import DEVICE_ID_R_SDK, DEVICE_ID_RANGE
+from gimbal.messages.base import is_flag
 from gimbal.sim.checks import check, integer, number
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 
@@ -48,9 +49,11 @@ _RATE, _SPEED, _TIME = "a finite rate above 0 Hz", "a finite speed above 0 °/s"
 _PUSH_RATE = (f"a rate above 0 Hz, at most {MAX_PUSH_RATE_HZ:g} Hz (a push takes several frames of a 1 Mbit/s bus)",
               number(0, MAX_PUSH_RATE_HZ, above=True))
 _CAN_ID = ("a standard CAN id, 0 to 0x7FF", integer(0, 0x7FF))
+_FLAG = "True or False"
 #: field: (what it takes, test); NaN and infinities fail every test.
 RULES = {
     "rx_id": _CAN_ID, "tx_id": _CAN_ID,
+    "legacy": (_FLAG, is_flag), "yaw_continuous": (_FLAG, is_flag), "camera_connected": (_FLAG, is_flag),
     "push_rate_hz": _PUSH_RATE,
     "tick_hz": (_RATE, number(0, above=True)),
     "max_speed_dps": (_SPEED, number(0, above=True)),

@@ -22,6 +22,7 @@ NAN, INF = math.nan, math.inf
     ("rx_id", 0x800), ("tx_id", -1), ("device_id", 0), ("version", 1 << 32), ("speed_signs", (1, 0, 1)),
     # 1e300 Hz once pushed ~10,000 times a second: 50,000 frames, several times what the bus carries
     ("push_rate_hz", 1e300), ("push_rate_hz", 1000.5), ("calibration_push_hz", 1e300),
+    ("legacy", "no"), ("yaw_continuous", 1), ("camera_connected", None),  # "no" once meant legacy firmware
 ])
 def test_sim_config_refuses(field: str, value: object) -> None:
     with pytest.raises(FieldError, match=rf"^SimConfig\.{field} takes .*, not ") as caught:
@@ -48,7 +49,7 @@ def test_the_edges_are_taken() -> None:
 def test_numpy_numbers_are_taken_and_answered(make_client) -> None:
     """Values read from a numpy array (a config file, a sweep) pass the checks as Python's do."""
     client, _ = make_client(SimConfig(version=np.uint32(0x01020304), device_id=np.int64(1), rx_id=np.int32(0x223),
-                                      tx_id=np.int16(0x222), push_rate_hz=np.float32(50.0)),
+                                      tx_id=np.int16(0x222), push_rate_hz=np.float32(50.0), legacy=np.False_),
                             Faults(nack_code=np.uint8(3), delay_s=np.float64(0.0)))
     reply = client.version()
     assert (reply.device_id, reply.version_text) == (1, "01.02.03.04")
