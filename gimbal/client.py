@@ -133,10 +133,10 @@ def _is_stop(message: Message) -> bool:
 
 def lookup(table: dict[str, int], value: str | int, what: str) -> int:
     """A named choice (or its raw number) from ``table``; RangeError otherwise."""
-    if isinstance(value, int) and not isinstance(value, bool):
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):  # numpy's too
         if value in table.values():
-            return value
-    elif value in table:
+            return int(value)
+    elif isinstance(value, str) and value in table:
         return table[value]
     raise RangeError(f"{what} {value!r} is not one of {', '.join(table)}")
 

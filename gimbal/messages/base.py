@@ -5,6 +5,7 @@ import dataclasses
 import struct
 from collections.abc import Mapping
 from enum import Enum
+from numbers import Integral
 from typing import Any, ClassVar, Self, TypeVar
 
 from gimbal.errors import PayloadError, RangeError
@@ -104,7 +105,7 @@ class Message:
             if missing:
                 raise RangeError(f"{self.NAME}.{name} is set but an earlier field is missing: "
                                  "only trailing fields may be left out")
-            if value.__class__ is not int and (not isinstance(value, int) or isinstance(value, bool)):
+            if value.__class__ is not int and (not isinstance(value, Integral) or isinstance(value, bool)):
                 raise RangeError(f"{self.NAME}.{name} must be an integer, not {value!r}")
             if not low <= value <= high:
                 raise RangeError(f"{self.NAME}.{name}={value} is outside {low}..{high}"
@@ -155,6 +156,8 @@ def _layout(cls: type[Message]) -> _Layout:
 
 
 def _jsonable(value: Any) -> Any:
+    if isinstance(value, Integral) and type(value) is not bool:  # numpy's integers too
+        return int(value)
     if isinstance(value, bytes):
         return value.hex()
     if isinstance(value, tuple | list):

@@ -3,14 +3,17 @@ setpoint's stamp that is not a finite number is refused by ``set()``, not later 
 thread (which stopped streaming with a TypeError)."""
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 
 import numpy as np
 import pytest
 
-from gimbal.client import GimbalClient, position_message, speed_message
+from gimbal.client import ORIENTATIONS, GimbalClient, position_message, speed_message
 from gimbal.errors import RangeError
 from gimbal.messages.motion import SpeedControl
+from gimbal.messages.settings import SetWorkMode
+from gimbal.messages.telemetry import PUSH_ENABLE, PushControl
 from tests.gimbal.scripted_peer import ScriptedPeer
 
 
@@ -50,3 +53,15 @@ def test_a_bad_stamp_is_refused_and_streaming_goes_on(client: GimbalClient, peer
     streamer.set(2.0, 0.0)
     peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 20)
     assert streamer.running and streamer.error is None
+
+
+def test_numpy_integers_make_the_same_commands(channel: str, peer: ScriptedPeer) -> None:
+    """Integer fields and raw choices computed with numpy: once "must be an integer, not
+    np.int64(1)" from the codec, or "orientation np.int64(1) is not one of ..." from the client."""
+    message = PushControl(np.int64(PUSH_ENABLE))
+    assert message.encode_payload() == PushControl(PUSH_ENABLE).encode_payload()
+    assert json.dumps(message.fields()) == json.dumps(PushControl(PUSH_ENABLE).fields())
+    peer.answer(SetWorkMode)
+    with GimbalClient(interface="virtual", channel=channel, timeout=0.2, retries=0) as client:
+        client.set_work_mode(np.int64(ORIENTATIONS["portrait"]))
+    assert [m.orientation for m in peer.messages(SetWorkMode)] == [ORIENTATIONS["portrait"]]
