@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 from gimbal.messages.telemetry import DEVICE_ID_R_SDK, DEVICE_ID_RANGE
 from gimbal.messages.base import is_flag
-from gimbal.sim.checks import check, integer, number
+from gimbal.sim.checks import FieldError, check, integer, number
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 
 
@@ -37,6 +37,8 @@ class SimConfig:
 
     def __post_init__(self) -> None:
         check(self, RULES)
+        if self.tx_id == self.rx_id:  # it would hear its own replies as commands
+            raise FieldError("SimConfig", "tx_id", f"an id other than rx_id (0x{self.rx_id:03X})", self.tx_id)
 
 
 #: Pushes a second at most. The document gives no rate for the parameter push (it gives 1 Hz for the

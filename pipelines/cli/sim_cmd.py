@@ -119,6 +119,7 @@ OPTION_OF_FIELD = {
 
 def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
     """The simulator's configuration and faults from the parsed options; ``CliError`` if invalid."""
+    check_sim_ids(args)  # in the options' words, before SimConfig's own check of the same
     try:
         config = SimConfig(rx_id=args.tx_id, tx_id=args.rx_id, legacy=args.legacy,
                            push_rate_hz=args.push_rate, accel_dps2=args.accel, base_yaw_deg=args.base_yaw,
@@ -139,7 +140,6 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
         raise CliError(f"--status-interval takes a finite interval, 0 s or more, not {args.status_interval:g}")
     if args.duration is not None and args.duration <= 0:
         raise CliError(f"--duration must be positive, not {args.duration}")
-    check_sim_ids(args)
     return config, faults
 
 
