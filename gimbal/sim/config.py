@@ -37,7 +37,7 @@ class SimConfig:
 
     def __post_init__(self) -> None:
         check(self, RULES)
-        if self.tx_id == self.rx_id:  # it would hear its own replies as commands
+        if self.tx_id == self.rx_id:
             raise FieldError("SimConfig", "tx_id", f"an id other than rx_id (0x{self.rx_id:03X})", self.tx_id)
 
 

@@ -23,7 +23,7 @@ NAN, INF = math.nan, math.inf
     # 1e300 Hz once pushed ~10,000 times a second: 50,000 frames, several times what the bus carries
     ("push_rate_hz", 1e300), ("push_rate_hz", 1000.5), ("calibration_push_hz", 1e300),
     ("legacy", "no"), ("yaw_continuous", 1), ("camera_connected", None),  # "no" once meant legacy firmware
-    ("tx_id", 0x223),  # the default rx_id: the simulator would hear its own replies as commands
+    ("tx_id", 0x223),  # the default rx_id
 ])
 def test_sim_config_refuses(field: str, value: object) -> None:
     with pytest.raises(FieldError, match=rf"^SimConfig\.{field} takes .*, not ") as caught:
