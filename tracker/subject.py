@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from numbers import Real
 
 import numpy as np
 
@@ -66,6 +67,7 @@ class SubjectTracker:
         """Start following ``box`` (x, y, w, h) in ``frame``; it may reach over the frame's edges
         (``ValueError`` when it misses the frame). Frames may be grey, BGR or BGRA."""
         frame = as_bgr_or_grey(frame)
+        _check_timestamp(timestamp)
         height, width = frame.shape[:2]
         box = start_box(tuple(float(v) for v in box), width, height)
         self._appearance = AppearanceModel(frame, box)
@@ -79,6 +81,7 @@ class SubjectTracker:
         if self._appearance is None:
             raise RuntimeError("SubjectTracker.update() before init()")
         frame = as_bgr_or_grey(frame)
+        _check_timestamp(timestamp)
         self._frame_index += 1
         s = self.settings
         predicted = self._kalman.predict(timestamp)
@@ -165,6 +168,12 @@ class SubjectTracker:
         box = self._kalman.box
         return TargetEstimate(box=box, velocity=self._kalman.velocity, confidence=float(np.clip(confidence, 0, 1)),
                               state=state, timestamp=timestamp, frame_index=self._frame_index)
+
+
+def _check_timestamp(timestamp: float) -> None:
+    """``ValueError`` unless ``timestamp`` is a finite number of seconds (the Kalman filter's clock)."""
+    if isinstance(timestamp, bool) or not isinstance(timestamp, Real) or not math.isfinite(timestamp):
+        raise ValueError(f"a frame's timestamp must be a finite number of seconds, not {timestamp!r}")
 
 
 def _usable(box: Box | None, score: float) -> tuple[Box | None, float]:
