@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import atexit
 import logging
-import numbers
 import threading
 import time
 from collections import Counter, deque
@@ -36,7 +35,6 @@ from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError,
 from gimbal.framer import Dropped
 from gimbal.messages import (Message, PayloadError, Reply, decode_message, is_device_push,
                              message_packet, reply_fits, reply_key)
-from gimbal.messages.base import is_flag
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, FocusPositionReply,
@@ -55,6 +53,7 @@ from gimbal.messages.tlv_params import (AutoCalibration, GetUserParams, SetUserP
 from gimbal.packet import REPLY_OPTIONAL, Packet, encode_packet
 from gimbal.pushes import PushCallback, PushHub
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport, with_default_bitrate
+from gimbal.values import integer, is_flag, number
 
 if TYPE_CHECKING:
     from gimbal.keepalive import SpeedStreamer
@@ -133,7 +132,7 @@ def _is_stop(message: Message) -> bool:
 
 def lookup(table: dict[str, int], value: str | int, what: str) -> int:
     """A named choice (or its raw number) from ``table``; RangeError otherwise."""
-    if isinstance(value, numbers.Integral) and not isinstance(value, bool):  # numpy's too
+    if integer(0)(value):  # numpy's too
         if value in table.values():
             return int(value)
     elif isinstance(value, str) and value in table:
@@ -144,9 +143,9 @@ def lookup(table: dict[str, int], value: str | int, what: str) -> int:
 def _checked_wait(timeout: float, retries: int) -> tuple[float, int]:
     """A reply timeout (s, above 0, at most ``MAX_TIMEOUT``) and retry count (an int, 0 or more) as
     float and int; ``ValueError`` naming what is wrong otherwise."""
-    if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real) or not 0 < timeout <= MAX_TIMEOUT:
+    if not number(0, MAX_TIMEOUT, above=True)(timeout):
         raise ValueError(f"timeout must be above 0 and at most {MAX_TIMEOUT:.0f} s, not {timeout!r}")
-    if isinstance(retries, bool) or not isinstance(retries, numbers.Integral) or retries < 0:
+    if not integer(0)(retries):
         raise ValueError(f"retries must be a whole number, 0 or more, not {retries!r}")
     return float(timeout), int(retries)
 
@@ -578,7 +577,7 @@ class GimbalClient:
         """The next ``cls`` push; ``GimbalTimeoutError`` after ``timeout`` s, the client's error at
         once if it is closed or loses the bus meanwhile. ``timeout`` must be a number, 0 to
         ``MAX_TIMEOUT`` s (``ValueError``)."""
-        if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real) or not 0 <= timeout <= MAX_TIMEOUT:
+        if not number(0, MAX_TIMEOUT)(timeout):
             raise ValueError(f"a push timeout must be 0 to {MAX_TIMEOUT:.0f} s, not {timeout!r}")
         self._check_alive()
         return self.pushes.wait(cls, timeout)

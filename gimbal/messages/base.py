@@ -138,12 +138,6 @@ class _Layout:
     checks: tuple[tuple[str, int, int, frozenset[int] | None], ...]
 
 
-def is_flag(value: object) -> bool:
-    """Whether ``value`` is True or False (numpy's bools too); 0, 1 and strings such as "no", which
-    Python takes as true, are not."""
-    return isinstance(value, bool) or (type(value).__module__ == "numpy" and type(value).__name__ in ("bool", "bool_"))
-
-
 def _layout(cls: type[Message]) -> _Layout:
     layout = cls.__dict__.get("_LAYOUT")
     if layout is None:

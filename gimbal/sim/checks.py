@@ -2,11 +2,9 @@
 the field, so that a front end (``gimbaltrack sim``) can name its own option instead."""
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
 from numbers import Integral, Real
 
-from gimbal.messages.base import is_flag
+from gimbal.values import Test, is_flag
 
 
 class FieldError(ValueError):
@@ -21,24 +19,6 @@ class FieldError(ValueError):
     def name(self) -> str:
         """``owner.field``."""
         return f"{self.owner}.{self.field}"
-
-
-#: A test of one value: False for anything out of range, NaN and infinities included.
-Test = Callable[[object], bool]
-
-
-def number(low: float = -math.inf, high: float = math.inf, *, above: bool = False) -> Test:
-    """Finite real numbers from ``low`` (or above it, with ``above``) to ``high``; no bools."""
-    def test(value: object) -> bool:
-        if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(value):
-            return False
-        return (low < value if above else low <= value) and value <= high
-    return test
-
-
-def integer(low: int, high: int) -> Test:
-    """Integers (numpy's too) from ``low`` to ``high``; no bools."""
-    return lambda value: isinstance(value, Integral) and not isinstance(value, bool) and low <= value <= high
 
 
 def check(instance: object, rules: dict[str, tuple[str, Test]]) -> None:

@@ -4,9 +4,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from gimbal.messages.telemetry import DEVICE_ID_R_SDK, DEVICE_ID_RANGE
-from gimbal.messages.base import is_flag
-from gimbal.sim.checks import FieldError, check, integer, number
+from gimbal.sim.checks import FieldError, check
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
+from gimbal.values import integer, is_flag, number
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,8 @@ import random
 from collections import Counter
 from dataclasses import dataclass
 
-from gimbal.sim.checks import check, integer, number
+from gimbal.sim.checks import check
+from gimbal.values import integer, number
 
 DIRECTIONS = ("both", "rx", "tx")
 FOREIGN_IDS = (0x530, 0x531, 0x426)  # DJI's internal accessory traffic seen on live buses
