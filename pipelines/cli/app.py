@@ -14,7 +14,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from gimbal.signals import SignalExit, blocked_signals, exit_on_signals
-from pipelines.cli.common import EXIT_INTERRUPTED, CliError
+from pipelines.cli.common import EXIT_INTERRUPTED, CliError, hold_on_devnull
 
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
 SUBCOMMAND_MODULES = [
@@ -157,16 +157,6 @@ def _unwritten(prog: str, exc: OSError, debug: bool) -> int:
 
 
 STDOUT_FD, STDERR_FD = 1, 2
-
-
-def hold_on_devnull(fd: int) -> None:
-    """Open /dev/null on ``fd``: one closed when the program started, so that no output file opened
-    later takes that number (and gets what is written to stdout or stderr, OpenCV's own included),
-    or one whose writes failed, so that nothing written later fails again."""
-    null = os.open(os.devnull, os.O_WRONLY)
-    if null != fd:
-        os.dup2(null, fd)
-        os.close(null)
 
 
 def closed_stderr() -> io.TextIOBase:
