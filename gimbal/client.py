@@ -27,7 +27,7 @@ from collections import Counter, deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from types import TracebackType
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import Any, TypeVar
 
 import can
 
@@ -40,8 +40,8 @@ from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, Focu
                                       FocusPositionControl, FocusPositionQuery, FocusPositionReply,
                                       JoystickPush)
 from gimbal.messages.motion import (ANGLES_ATTITUDE, ANGLES_JOINT, AXES, POSITION_ABSOLUTE,
-                                    POSITION_INVALID, SPEED_IGNORE_FOCAL_LENGTH, SPEED_TAKE_CONTROL,
-                                    GetAngles, PositionControl, SpeedControl, from_raw, to_raw)
+                                    POSITION_INVALID, SPEED_HOLD, SPEED_RELEASE, SPEED_TAKE_CONTROL,
+                                    AnglesReply, GetAngles, PositionControl, SpeedControl, to_raw)
 from gimbal.messages.settings import (FOLLOW_FPV, FOLLOW_LOCK, FOLLOW_YAW, SELFIE, ActiveTrack,
                                       AngleLimitsReply, GetAngleLimits, GetMotorStiffness,
                                       MotorStiffnessReply, RecenterSelfie, SetAngleLimits,
@@ -51,12 +51,11 @@ from gimbal.messages.telemetry import (DEVICE_ID_R_SDK, PUSH_DISABLE, PUSH_ENABL
 from gimbal.messages.tlv_params import (AutoCalibration, GetUserParams, SetUserParams, Tlv,
                                         autotune)
 from gimbal.packet import REPLY_OPTIONAL, Packet, encode_packet
+from gimbal.keepalive import DEFAULT_MAX_AGE_S, SpeedStreamer
+from gimbal.matcher import PendingReply
 from gimbal.pushes import PushCallback, PushHub
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport, with_default_bitrate
 from gimbal.values import integer, is_flag, number
-
-if TYPE_CHECKING:
-    from gimbal.keepalive import SpeedStreamer
 
 log = logging.getLogger(__name__)
 
@@ -71,9 +70,6 @@ FOLLOW_MODES = {"lock": FOLLOW_LOCK, "yaw": FOLLOW_YAW, "fpv": FOLLOW_FPV}
 ORIENTATIONS = {"keep": 0x00, "landscape": 0x01, "landscape-flipped": 0x02, "portrait": 0x03,
                 "portrait-flipped": 0x04, "toggle": 0x05, "default": 0xFF}
 FOCUS_CALIBRATIONS = {name.replace("_", "-"): code for code, name in FOCUS_CALIBRATION_COMMANDS.items()}
-SPEED_HOLD = SPEED_TAKE_CONTROL | SPEED_IGNORE_FOCAL_LENGTH  # 0x88: in control
-SPEED_RELEASE = SPEED_IGNORE_FOCAL_LENGTH  # 0x08: bit 7 clear, control released
-DEFAULT_MAX_AGE_S = 0.3  # the speed keep-alive replaces a setpoint this old by zero
 
 R = TypeVar("R", bound=Reply)
 
@@ -115,7 +111,7 @@ def flag(value: bool, name: str) -> bool:
 
 def speed_message(yaw: float, pitch: float, roll: float = 0.0, *,
                   take_control: bool = True) -> SpeedControl:
-    """Speed control in °/s (±360); bit 7 of ctrl_byte takes (or releases) control."""
+    """Speed control in °/s (±``MAX_SPEED_DPS``); bit 7 of ctrl_byte takes (or releases) control."""
     ctrl = SPEED_HOLD if flag(take_control, "take_control") else SPEED_RELEASE
     return SpeedControl(to_raw(yaw, "yaw speed"), to_raw(roll, "roll speed"),
                         to_raw(pitch, "pitch speed"), ctrl)
@@ -148,35 +144,6 @@ def _checked_wait(timeout: float, retries: int) -> tuple[float, int]:
     if not integer(0)(retries):
         raise ValueError(f"retries must be a whole number, 0 or more, not {retries!r}")
     return float(timeout), int(retries)
-
-
-class PendingReply:
-    """A command on the bus waiting for its reply; ``raw`` is its packet as sent (and resent)."""
-
-    def __init__(self, request: Message, seq: int, raw: bytes) -> None:
-        self.request = request
-        self.seq = seq
-        self.raw = raw
-        self.key = (request.CMD_SET, request.CMD_ID)
-        self.packet: Packet | None = None
-        self.error: BaseException | None = None
-        self._event = threading.Event()
-
-    @property
-    def done(self) -> bool:
-        return self._event.is_set()
-
-    def wait(self, timeout: float) -> bool:
-        """True once a reply (or a bus failure) arrived."""
-        return self._event.wait(timeout)
-
-    def resolve(self, packet: Packet) -> None:
-        self.packet = packet
-        self._event.set()
-
-    def fail(self, error: BaseException) -> None:
-        self.error = error
-        self._event.set()
 
 
 class GimbalClient:
@@ -597,7 +564,6 @@ class GimbalClient:
 
     def speed_streamer(self, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S) -> SpeedStreamer:
         """Start the speed keep-alive (see ``gimbal.keepalive``); one per client at a time."""
-        from gimbal.keepalive import SpeedStreamer
         self._check_alive()
         if self._streamer is not None and self._streamer.running:
             raise GimbalError("a speed streamer is already running; stop() it first")
@@ -607,12 +573,12 @@ class GimbalClient:
     def get_angles(self, kind: str = "attitude") -> Angles:
         """Attitude or joint angles in degrees."""
         code = lookup(ANGLE_KINDS, kind, "angle kind")
-        reply = self._ask(GetAngles(code), Reply)
-        if getattr(reply, "data_type", None) != code or getattr(reply, "pitch", None) is None:
-            raise GimbalError(f"the gimbal has no {kind} angles ready (data_type "
-                              f"{getattr(reply, 'data_type', None)})")
+        reply = self._ask(GetAngles(code), AnglesReply)
+        degrees = reply.degrees
+        if reply.data_type != code or degrees is None:
+            raise GimbalError(f"the gimbal has no {kind} angles ready (data_type {reply.data_type})")
         name = next(k for k, v in ANGLE_KINDS.items() if v == code)
-        return Angles(name, *(from_raw(getattr(reply, axis)) for axis in AXES))
+        return Angles(name, *degrees)
 
     # -- settings --------------------------------------------------------------------------
 

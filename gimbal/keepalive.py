@@ -15,20 +15,38 @@ import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
 
 import can
 
-from gimbal.client import DEFAULT_MAX_AGE_S, SPEED_HOLD, GimbalClient, PendingReply
 from gimbal.errors import BusError, GimbalError, SendError
-from gimbal.messages.motion import SpeedControl, finite_number, to_raw
+from gimbal.messages import Message, Reply
+from gimbal.messages.limits import MAX_SPEED_DPS, SPEED_COMMAND_LASTS_S
+from gimbal.messages.motion import SPEED_HOLD, SpeedControl, finite_number, to_raw
+
+if TYPE_CHECKING:
+    from gimbal.matcher import PendingReply
 
 log = logging.getLogger(__name__)
 
-MAX_SPEED_DPS = 360.0
+DEFAULT_MAX_AGE_S = 0.3  # a setpoint this old is replaced by zero speed
 STAT_KEYS = ("sent", "zero_sent", "replies", "reply_errors", "reply_timeouts", "send_errors")  # from the start
-MIN_RATE_HZ = 4.0  # at least two sends inside the gimbal's 0.5 s window
+MIN_RATE_HZ = 2 / SPEED_COMMAND_LASTS_S  # at least two sends inside the time one command lasts
 MAX_RATE_HZ = 50.0  # public drivers use 10-50 Hz; a new setpoint may go out at twice the rate, and
 # each reply (a few ms) must be back by the next send, half a period later at the least
+
+
+class SpeedSender(Protocol):
+    """What the keep-alive needs from a client: send a command without waiting, collect or drop
+    its reply, and the safety stop."""
+
+    def submit(self, message: Message) -> PendingReply: ...
+
+    def cancel(self, waiter: PendingReply) -> None: ...
+
+    def result(self, waiter: PendingReply) -> Reply: ...
+
+    def stop_and_release(self) -> None: ...
 
 
 @dataclass
@@ -56,7 +74,7 @@ class SpeedStreamer:
     set and the next ``set()`` raises ``BusError``.
     """
 
-    def __init__(self, client: GimbalClient, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S, *,
+    def __init__(self, client: SpeedSender, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S, *,
                  max_missed_replies: int = 10, clock: Callable[[], float] = time.monotonic) -> None:
         if not MIN_RATE_HZ <= rate_hz <= MAX_RATE_HZ:
             raise ValueError(f"the keep-alive rate must be {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz (a command "
