@@ -14,10 +14,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, MAX_TIMEOUT, ORIENTATIONS,
-                           FIRST_SEQ, GimbalClient, lookup, position_message, speed_message)
+from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, GimbalClient,
+                           lookup, position_message, speed_message)
 from gimbal.errors import GimbalError, GimbalTimeoutError, RangeError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
+from gimbal.matcher import FIRST_SEQ
 from gimbal.messages import Message, message_packet
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_STATES, DialPush, FocusCalibration,
@@ -34,6 +35,7 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
                                         GetUserParams, SetUserParams, Tlv, autotune,
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
+from gimbal.session import MAX_TIMEOUT
 from pipelines.cli.bus import open_host_bus
 from pipelines.cli.common import (CliError, add_bus_options, hold_on_devnull, parse_int, parse_seconds,
                                   suppress_defaults)
