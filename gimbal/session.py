@@ -33,6 +33,7 @@ from gimbal.errors import (
     ReturnCodeError,
     SendError,
 )
+from gimbal.framer import PacketFramer
 from gimbal.keepalive import DEFAULT_MAX_AGE_S, SpeedStreamer
 from gimbal.matcher import PendingReply, ReplyMatcher
 from gimbal.messages import Message, Reply, decode_message
@@ -44,7 +45,13 @@ from gimbal.messages.motion import (
 )
 from gimbal.packet import REPLY_OPTIONAL
 from gimbal.pushes import PushCallback, PushHub
-from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport, with_default_bitrate
+from gimbal.transport import (
+    HOST_RX_ID,
+    HOST_TX_ID,
+    CanTransport,
+    is_packet_frame,
+    with_default_bitrate,
+)
 from gimbal.values import integer, number
 
 log = logging.getLogger(__name__)
@@ -95,15 +102,28 @@ class _BusWatch(can.Listener):
 class _Taps(can.Listener):
     """The listeners that want every frame as the bus saw it (a CAN log). On a bus that loops our
     own frames back marked as received (udp_multicast) those echoes are left out: the taps got
-    each of our frames at send already."""
+    each of our frames at send already. Once the client closes (``close_at_packet_end``) they get
+    frames until the gimbal's stream is between two packets, so a log never ends with half of one
+    that the client did not read either."""
 
     def __init__(self, transport: CanTransport) -> None:
         self.listeners: list[can.Listener] = []
         self._transport = transport
+        self._gimbal_stream = PacketFramer()  # where the gimbal's packets start and end
+        self._closing = False
+        self._closed = False
+
+    def close_at_packet_end(self) -> None:
+        self._closing = True
 
     def on_message_received(self, msg: can.Message) -> None:
-        if not self.listeners or self._transport.take_echo(msg):
+        if not self.listeners or self._closed or self._transport.take_echo(msg):
             return
+        if is_packet_frame(msg, self._transport.rx_id):
+            if self._closing and not self._gimbal_stream.pending:
+                self._closed = True  # this frame would start a packet nobody reads to its end
+                return
+            self._gimbal_stream.feed_frame(bytes(msg.data))
         for listener in self.listeners:
             listener.on_message_received(msg)
 
@@ -195,6 +215,7 @@ class GimbalSession:
         finally:
             self._closed = True
             self._closing.set()
+            self._taps.close_at_packet_end()
             self.replies.fail_all(GimbalError("client closed"))
             self.pushes.interrupt(GimbalError("the gimbal client is closed"))
             if self._on_receive_thread():  # close() from a push callback: the Notifier cannot join itself
