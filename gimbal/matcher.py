@@ -11,8 +11,9 @@ reply then arrives echoing our SEQ, echoing is learnt (``misattributed_replies``
 the requests then waiting for that command (usually one), not every later one.
 
 A reply that echoes the SEQ of a request given up on (timed out, cancelled) is late
-(``late_replies``, counted among the ``stale_replies``): it shows the gimbal echoes SEQs and is
-dropped, never handed to a newer request for the same command. SEQs of requests given up on are
+(``late_replies``, counted among the ``stale_replies``): it shows the gimbal echoes SEQs, marks
+that request answered late (``PendingReply.late``) and is never handed to a newer request for the
+same command. SEQs of requests given up on are
 not handed out again while they are remembered, so such a reply cannot be mistaken either.
 Replies that match no outstanding request (``stale_replies``), or are too short to name the
 command they answer (``bad_replies``), are counted and dropped.
@@ -54,6 +55,7 @@ class PendingReply:
         self.key = (request.CMD_SET, request.CMD_ID)
         self.packet: Packet | None = None
         self.error: BaseException | None = None
+        self.late = False  # answered after it was given up on
         self._event = threading.Event()
 
     @property
@@ -170,7 +172,7 @@ class ReplyMatcher(PacketListener):
             if not echoed:
                 given_up = self._given_up.get(packet.seq)
                 if given_up is not None and given_up.answered_by(packet, key):
-                    self._late(given_up)
+                    self._late(given_up, packet)
                     return None
                 waiter = next((w for w in self._pending.values() if w.answered_by(packet, key)), None)
                 if waiter is None and (packet.seq, key) in self._paired_by_command:
@@ -184,11 +186,14 @@ class ReplyMatcher(PacketListener):
                     self._paired_by_command.append((waiter.seq, key))
             return waiter
 
-    def _late(self, waiter: PendingReply) -> None:
-        """A reply to a request given up on: it echoes that request's SEQ (lock held)."""
+    def _late(self, waiter: PendingReply, packet: Packet) -> None:
+        """A reply to a request given up on: it echoes that request's SEQ. The request is marked
+        answered late (for whoever still looks, the keep-alive), and handed to nobody (lock held)."""
         self.stats["late_replies"] += 1
         del self._given_up[waiter.seq]
         self._note_echo(True, False)
+        waiter.late = True
+        waiter.resolve(packet)
         log.debug("late reply to %s (SEQ 0x%04X), dropped", waiter.request.NAME, waiter.seq)
 
     def _late_echo(self, seq: int) -> None:

@@ -202,12 +202,13 @@ def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:
     finally:
         streamer.stop()
     stats = streamer.stats
-    if stats["reply_errors"] or (stats["reply_timeouts"] and not stats["replies"]):
+    if stats["reply_errors"] or (stats["reply_timeouts"] and not (stats["replies"] or stats["late_replies"])):
         failed = " and ".join(f"{what} {stats[key]}" for what, key in (("refused", "reply_errors"),
                                                                      ("did not answer", "reply_timeouts"))
                               if stats[key])
         raise CliError(f"the gimbal {failed} of {stats['sent']} speed commands", exit_code=1)
-    return {"duration_s": args.duration, **{k: stats[k] for k in ("sent", "reply_errors", "reply_timeouts")}}
+    counts = ("sent", "reply_errors", "reply_timeouts", "late_replies")
+    return {"duration_s": args.duration, **{k: stats[k] for k in counts}}
 
 
 def _limits_args(p: argparse.ArgumentParser) -> None:

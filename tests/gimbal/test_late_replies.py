@@ -33,16 +33,28 @@ def test_a_late_reply_never_answers_a_newer_request(channel: str, peer: Scripted
 
 def test_a_slow_gimbal_under_the_keep_alive_gets_no_reply_paired_with_a_newer_command(
         channel: str, peer: ScriptedPeer, caplog: pytest.LogCaptureFixture) -> None:
+    """At 25 Hz every reply misses its command's 40 ms window: each is late, none is taken for
+    a newer command's, and the late ones show the gimbal hears us, so streaming goes on."""
     peer.answer(SpeedControl, delay=DELAY_S)
     with caplog.at_level(logging.WARNING), GimbalClient(interface="virtual", channel=channel) as client:
         streamer = client.speed_streamer(rate_hz=25.0, max_age=60.0)
         streamer.set(10.0, 0.0)
-        poll(lambda: streamer.error is not None)  # every reply missed its send's window
-        with pytest.raises(BusError):
-            streamer.set(10.0, 0.0)
+        poll(lambda: streamer.stats["late_replies"] >= 2 * streamer.max_missed_replies)
+        assert streamer.error is None and streamer.running
         streamer.stop()
-        poll(lambda: client.stats["late_replies"] >= streamer.max_missed_replies)
         assert streamer.stats["replies"] == 0
-        assert streamer.stats["reply_timeouts"] == streamer.max_missed_replies
+        assert client.stats["late_replies"] >= streamer.stats["late_replies"]
         assert client.stats["misattributed_replies"] == 0
     assert "another host" not in caplog.text
+
+
+def test_a_gimbal_that_goes_silent_after_answering_late_is_still_lost(channel: str, peer: ScriptedPeer) -> None:
+    peer.answer(SpeedControl, delay=DELAY_S)
+    with GimbalClient(interface="virtual", channel=channel) as client:
+        streamer = client.speed_streamer(rate_hz=25.0, max_age=60.0)
+        streamer.set(10.0, 0.0)
+        poll(lambda: streamer.stats["late_replies"] >= 3)
+        peer.silence(SpeedControl)
+        poll(lambda: streamer.error is not None)
+        with pytest.raises(BusError):
+            streamer.set(10.0, 0.0)
