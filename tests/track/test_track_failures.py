@@ -6,6 +6,7 @@ from __future__ import annotations
 import errno
 import json
 import signal
+import threading
 import time
 from pathlib import Path
 
@@ -166,8 +167,11 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
     sim = start(cli_command("sim", "-i", "udp_multicast", "-c", GROUP, "--status-interval", "0.1", "--json"),
                 env)
     out = tmp_path / "out"
+    reports: list[str] = []  # read as printed: a full stdout pipe (64 KiB, ~6 s of reports) stalls the simulator
+    reader = threading.Thread(target=lambda: reports.extend(sim.stdout), daemon=True)  # type: ignore[arg-type]
     try:
         _wait_for(lambda: sim.stdout.readline() != "", 10, "the simulator")  # type: ignore[union-attr]
+        reader.start()
         track = start(track_command(DEMO, out, "--roi", DEMO_ROI, "--realtime", "-i", "udp_multicast",
                                     "-c", GROUP), env)
         telemetry = out / "telemetry.jsonl"
@@ -182,7 +186,10 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
         time.sleep(0.5)  # the simulator decelerates (720 deg/s^2) and reports every 0.1 s
     finally:
         sim.send_signal(signal.SIGTERM)
-        sim_out, _ = sim.communicate(timeout=10)
+        sim.wait(timeout=10)
+        if reader.ident is not None:  # started
+            reader.join(timeout=10)
+    sim_out = "".join(reports)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == status and status in stdout
     frames = summary["frames"]
