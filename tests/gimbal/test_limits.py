@@ -9,7 +9,12 @@ import pytest
 from gimbal import keepalive
 from gimbal.errors import RangeError
 from gimbal.messages import limits
-from gimbal.messages.motion import AnglesReply, AxisDegrees, PositionControl, SpeedControl
+from gimbal.messages.motion import (
+    AnglesReply,
+    AxisDegrees,
+    PositionControl,
+    SpeedControl,
+)
 from gimbal.messages.telemetry import ParameterPush
 from pipelines.cli.gimbal_cmd import register
 from pipelines.control import limits as control_limits

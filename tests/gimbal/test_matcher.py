@@ -4,9 +4,20 @@ from __future__ import annotations
 import can
 import pytest
 
-from gimbal.matcher import ECHO_EVIDENCE, FIRST_SEQ, GIVEN_UP_KEPT, PendingReply, ReplyMatcher
+from gimbal.matcher import (
+    ECHO_EVIDENCE,
+    FIRST_SEQ,
+    GIVEN_UP_KEPT,
+    PendingReply,
+    ReplyMatcher,
+)
 from gimbal.messages import Message, message_packet
-from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl, SpeedControlReply
+from gimbal.messages.motion import (
+    AnglesReply,
+    GetAngles,
+    SpeedControl,
+    SpeedControlReply,
+)
 from gimbal.messages.telemetry import ParameterPush, VersionQuery, VersionReply
 from gimbal.packet import REPLY_CMD_TYPE, Packet, encode_packet
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID, packet_frames

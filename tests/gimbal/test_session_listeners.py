@@ -1,6 +1,8 @@
 """The client's can.Notifier is shared: any python-can listener sees the bus's traffic and ours."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import can
 import pytest
 
@@ -67,3 +69,13 @@ def test_closing_lets_the_taps_finish_the_packet_in_progress_and_no_more(channel
     finally:
         bus.shutdown()
     assert [bytes(f.data) for f in _drain(reader)] == [bytes(f.data) for f in push]
+
+
+def test_python_cans_own_logger_records_both_directions(channel: str, peer: ScriptedPeer, tmp_path: Path) -> None:
+    """Any python-can log format works as a tap: here ``.asc``, whose lines say Tx or Rx."""
+    peer.answer(GetAngles, AnglesReply(0, 1, 10, 20, 30))
+    path = tmp_path / "session.asc"
+    with GimbalClient(interface="virtual", channel=channel, listeners=[can.Logger(path)]) as client:
+        client.get_angles()
+    directions = {(m.arbitration_id, m.is_rx) for m in can.LogReader(path)}
+    assert directions == {(HOST_TX_ID, False), (HOST_RX_ID, True)}
