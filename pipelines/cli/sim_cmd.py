@@ -17,6 +17,7 @@ from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
 from gimbal.sim.checks import FieldError
 from gimbal.sim.config import MAX_PUSH_RATE_HZ
 from gimbal.sim.faults import DIRECTIONS
+from gimbal.sim.slcan_pty import SlcanPty, virtual_pair
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, check_sim_ids, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
 
@@ -30,6 +31,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "'gimbaltrack sim -i udp_multicast -c 239.74.163.2'. The id options keep the host's point of "
         "view: the simulator listens on --tx-id and answers on --rx-id.")
     add_bus_options(parser, default_interface="udp_multicast", offers_sim=False)
+    parser.add_argument("--slcan-pty", action="store_true",
+                        help="instead of -i/-c/-b: be a USB-CAN adapter speaking SLCAN on a pseudo-terminal "
+                        "whose path is printed first on standard output; drive it with '-i slcan -c PATH'")
     model = parser.add_argument_group("device")
     model.add_argument("--legacy", action="store_true", help="old firmware: replies omit CmdSet/CmdID")
     model.add_argument("--push-rate", type=float, default=SimConfig.push_rate_hz, metavar="HZ",
@@ -150,7 +154,12 @@ def _given(value: float | tuple[float, float]) -> str:
     return str(value) if isinstance(value, int) else f"{value:g}"
 
 
-def open_bus(args: argparse.Namespace) -> can.BusABC:
+def open_bus(args: argparse.Namespace) -> can.BusABC | None:
+    """The bus the simulator answers on; None for --slcan-pty (``run`` makes that one)."""
+    if args.slcan_pty:
+        if args.channel is not None or args.bitrate is not None or args.interface != "udp_multicast":
+            raise CliError("--slcan-pty is the bus: it takes no -i/--interface, -c/--channel or -b/--bitrate")
+        return None
     if args.interface == SIM_INTERFACE:
         raise CliError("'-i sim' is the in-process simulator; give 'sim' a real bus, e.g. -i udp_multicast")
     return open_can_bus(bus_options(args))
@@ -170,6 +179,11 @@ def status_line(state: SimState, elapsed: float) -> str:
 def run(args: argparse.Namespace) -> int:
     config, faults = build(args)
     bus = open_bus(args)
+    adapter: SlcanPty | None = None
+    if bus is None:  # --slcan-pty: the gimbal on one end of a virtual bus, the adapter on the other
+        adapter_bus, bus = virtual_pair()
+        adapter = SlcanPty(adapter_bus).start()
+        print(adapter.path, flush=True)
     stop = threading.Event()
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
@@ -197,5 +211,8 @@ def run(args: argparse.Namespace) -> int:
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
+        if adapter is not None:
+            adapter.stop()
+            adapter.bus.shutdown()
         bus.shutdown()
     return 0
