@@ -20,6 +20,7 @@ from gimbal.sim.faults import DIRECTIONS
 from gimbal.sim.slcan_pty import SlcanPty, virtual_pair
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, check_sim_ids, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
+from pipelines.cli.firmware_opts import add_legacy_order_option
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -36,6 +37,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "whose path is printed first on standard output; drive it with '-i slcan -c PATH'")
     model = parser.add_argument_group("device")
     model.add_argument("--legacy", action="store_true", help="old firmware: replies omit CmdSet/CmdID")
+    add_legacy_order_option(model)
+    model.add_argument("--push-reply-bit", action="store_true",
+                       help="send the parameter and calibration pushes with CmdType 0x20, as some firmware does")
+    model.add_argument("--lenient", action="store_true",
+                       help="answer get requests for limits, stiffness and user parameters sent without "
+                       "their payload (default: refused as a parse error, 0x01)")
     model.add_argument("--push-rate", type=float, default=SimConfig.push_rate_hz, metavar="HZ",
                        help=f"parameter push rate once enabled, above 0 up to {MAX_PUSH_RATE_HZ:g} (default %(default)s)")
     model.add_argument("--accel", type=float, default=SimConfig.accel_dps2, metavar="DPS2",
@@ -126,6 +133,8 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
     check_sim_ids(args)  # in the options' words, before SimConfig's own check of the same
     try:
         config = SimConfig(rx_id=args.tx_id, tx_id=args.rx_id, legacy=args.legacy,
+                           legacy_attitude_order=args.legacy_order, push_reply_bit=args.push_reply_bit,
+                           lenient=args.lenient,
                            push_rate_hz=args.push_rate, accel_dps2=args.accel, base_yaw_deg=args.base_yaw,
                            yaw_continuous=args.yaw_continuous, version=args.version,
                            calibration_s=args.calibration_time, camera_connected=not args.no_camera,
