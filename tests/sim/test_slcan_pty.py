@@ -113,3 +113,12 @@ def test_gimbal_and_track_over_slcan_against_the_sim_process(tmp_path: Path) -> 
     last = json.loads(lines[-1])  # a status line from the last 0.2 s
     assert last["speeds"] == [0.0, 0.0, 0.0] and not last["speed_control"]
     assert last["commands"].get("speed_control", 0) > 10, last
+
+
+@pytest.mark.parametrize("extra", [["-c", "/dev/ttyACM0"], ["-b", "500000"], ["-i", "virtual"]])
+def test_slcan_pty_refuses_bus_options_in_one_line(extra: list[str]) -> None:
+    done = subprocess.run(cli_command("sim", "--slcan-pty", *extra, "--duration", "2"), capture_output=True,
+                          text=True, timeout=60, cwd=ROOT, env=subprocess_env())
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.strip().splitlines() == [
+        "gimbaltrack sim: error: --slcan-pty is the bus: it takes no -i/--interface, -c/--channel or -b/--bitrate"]
