@@ -37,6 +37,7 @@ from gimbal.framer import PacketFramer
 from gimbal.keepalive import DEFAULT_MAX_AGE_S, SpeedStreamer
 from gimbal.matcher import PendingReply, ReplyMatcher
 from gimbal.messages import Message, Reply, decode_message
+from gimbal.messages.firmware import LEGACY_ORDER_DOCUMENT, check_legacy_order
 from gimbal.messages.motion import (
     SPEED_HOLD,
     SPEED_RELEASE,
@@ -146,8 +147,10 @@ class GimbalSession:
 
     def __init__(self, bus: can.BusABC | None = None, *, tx_id: int = HOST_TX_ID,
                  rx_id: int = HOST_RX_ID, timeout: float = 0.1, retries: int = 2,
-                 listeners: Iterable[can.Listener] = (), **bus_kwargs: Any) -> None:
+                 listeners: Iterable[can.Listener] = (), legacy_attitude_order: str = LEGACY_ORDER_DOCUMENT,
+                 **bus_kwargs: Any) -> None:
         timeout, retries = _checked_wait(timeout, retries)
+        self.legacy_attitude_order = check_legacy_order(legacy_attitude_order)  # of legacy angle replies
         self._owns_bus = bus is None
         if bus is None:
             try:
@@ -354,7 +357,7 @@ class GimbalSession:
             raise BusError(f"{waiter.request.NAME}: {waiter.error}") from waiter.error
         if waiter.packet is None:
             raise GimbalTimeoutError(f"{waiter.request.NAME}: no reply yet")
-        reply = decode_message(waiter.packet, waiter.request)
+        reply = decode_message(waiter.packet, waiter.request, self.legacy_attitude_order)
         code = getattr(reply, "return_code", None)
         if code is None:
             raise GimbalError(f"{waiter.request.NAME}: answered by {reply.NAME}, not a reply")

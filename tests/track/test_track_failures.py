@@ -167,11 +167,13 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
     sim = start(cli_command("sim", "-i", "udp_multicast", "-c", GROUP, "--status-interval", "0.1", "--json"),
                 env)
     out = tmp_path / "out"
-    reports: list[str] = []  # read as printed: a full stdout pipe (64 KiB, ~6 s of reports) stalls the simulator
-    reader = threading.Thread(target=lambda: reports.extend(sim.stdout), daemon=True)  # type: ignore[arg-type]
+    # Read the status lines as they come: a pipe left unread fills (~10 s at 10 lines/s) and stalls
+    # the simulator, whose last line would then be an old one from mid-run.
+    sim_lines: list[str] = []
+    reader = threading.Thread(target=lambda: sim_lines.extend(sim.stdout), daemon=True)  # type: ignore[arg-type]
+    reader.start()
     try:
-        _wait_for(lambda: sim.stdout.readline() != "", 10, "the simulator")  # type: ignore[union-attr]
-        reader.start()
+        _wait_for(lambda: sim_lines, 30, "the simulator")
         track = start(track_command(DEMO, out, "--roi", DEMO_ROI, "--realtime", "-i", "udp_multicast",
                                     "-c", GROUP), env)
         telemetry = out / "telemetry.jsonl"
@@ -187,9 +189,7 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
     finally:
         sim.send_signal(signal.SIGTERM)
         sim.wait(timeout=10)
-        if reader.ident is not None:  # started
-            reader.join(timeout=10)
-    sim_out = "".join(reports)
+        reader.join(timeout=10)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == status and status in stdout
     frames = summary["frames"]
@@ -198,7 +198,7 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
     records = decoded(out / "can.log")
     assert any(not c.zero for c in speed_commands(records)), "the gimbal never moved"
     assert_stopped_at_end(records)
-    final = json.loads(sim_out.strip().splitlines()[-1])
+    final = json.loads(sim_lines[-1])
     assert final["speeds"] == [0.0, 0.0, 0.0] and not final["moving"] and not final["speed_control"]
 
 
