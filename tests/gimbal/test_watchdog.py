@@ -1,0 +1,118 @@
+"""The bus watchdog alone, on a fake clock: states, counts and the snapshot's shape."""
+from __future__ import annotations
+
+import pytest
+
+from gimbal.watchdog import DEGRADED, DISENGAGED, ENGAGED, BusWatchdog
+
+
+class FakeClock:
+    def __init__(self) -> None:
+        self.t = 100.0
+
+    def __call__(self) -> float:
+        return self.t
+
+    def advance(self, dt: float) -> None:
+        self.t += dt
+
+
+def ticks(dog: BusWatchdog, clock: FakeClock, n: int, *, answered: bool, period: float = 0.04) -> None:
+    """``n`` keep-alive commands, each answered in time or never."""
+    for _ in range(n):
+        clock.advance(period)
+        if answered:
+            dog.replied()
+        else:
+            dog.timed_out()
+            dog.unanswered()
+
+
+@pytest.fixture
+def clock() -> FakeClock:
+    return FakeClock()
+
+
+def test_a_clean_link_stays_engaged(clock: FakeClock) -> None:
+    dog = BusWatchdog(clock=clock)
+    ticks(dog, clock, 200, answered=True)
+    health = dog.snapshot()
+    assert health.state == ENGAGED and health.clean
+    assert (health.unanswered, health.episodes, health.unreachable_s) == (0, 0, 0.0)
+
+
+def test_one_lost_reply_is_not_an_episode_but_two_are(clock: FakeClock) -> None:
+    dog = BusWatchdog(clock=clock)
+    ticks(dog, clock, 1, answered=False)
+    ticks(dog, clock, 1, answered=True)
+    assert dog.poll() == ENGAGED
+    ticks(dog, clock, 1, answered=False)
+    assert dog.poll() == DEGRADED
+    assert dog.snapshot().episodes == 1
+
+
+def test_degraded_until_a_whole_window_is_answered(clock: FakeClock) -> None:
+    dog = BusWatchdog(clock=clock, window=25)
+    ticks(dog, clock, 3, answered=False)
+    assert dog.poll() == DEGRADED
+    ticks(dog, clock, 24, answered=True)
+    assert dog.poll() == DEGRADED
+    ticks(dog, clock, 1, answered=True)
+    assert dog.poll() == ENGAGED
+
+
+def test_a_short_silence_degrades_at_once_and_counts_as_unreachable(clock: FakeClock) -> None:
+    dog = BusWatchdog(clock=clock)
+    ticks(dog, clock, 10, answered=True)
+    clock.advance(0.35)  # nothing comes back for 0.35 s
+    assert dog.poll() == DEGRADED
+    dog.replied()
+    health = dog.snapshot()
+    assert health.unreachable_s == pytest.approx(0.35)
+    assert health.disengagements == 0
+
+
+def test_silence_of_the_timeout_disengages_and_a_reply_reengages(clock: FakeClock) -> None:
+    dog = BusWatchdog(2.0, clock=clock)
+    ticks(dog, clock, 5, answered=True)
+    heard = clock.t
+    ticks(dog, clock, 49, answered=False)  # 1.96 s
+    assert dog.poll() == DEGRADED
+    clock.advance(0.04)
+    assert dog.poll() == DISENGAGED
+    assert dog.snapshot().since == pytest.approx(heard + 2.0)
+    clock.advance(3.0)
+    assert dog.snapshot().unreachable_s == pytest.approx(5.0)  # the ongoing silence is included
+    dog.replied()
+    health = dog.snapshot()
+    assert health.state == DEGRADED  # in control again; engaged once a window is answered
+    assert (health.episodes, health.disengagements) == (1, 1)
+    assert health.unreachable_s == pytest.approx(5.0)
+    ticks(dog, clock, 25, answered=True)
+    assert dog.poll() == ENGAGED
+
+
+def test_late_replies_and_nacks_show_the_gimbal_hears(clock: FakeClock) -> None:
+    """A 150 ms reply delay: every command times out and is answered late; not a bad link."""
+    dog = BusWatchdog(clock=clock)
+    for _ in range(100):
+        clock.advance(0.04)
+        dog.timed_out()
+        dog.replied(late=True)
+    dog.replied(nack=True)
+    health = dog.snapshot()
+    assert health.state == ENGAGED
+    assert (health.timeouts, health.late, health.nacks, health.unanswered) == (100, 100, 1, 0)
+
+
+def test_the_snapshot_is_plain_data(clock: FakeClock) -> None:
+    health = BusWatchdog(clock=clock).snapshot()
+    assert set(health.as_dict()) == {"state", "since", "unanswered", "late", "timeouts", "nacks",
+                                     "unreachable_s", "episodes", "disengagements"}
+    with pytest.raises(AttributeError):
+        health.state = DEGRADED  # type: ignore[misc]
+
+
+def test_a_timeout_at_or_below_the_degraded_silence_is_refused() -> None:
+    with pytest.raises(ValueError, match="bus timeout"):
+        BusWatchdog(0.3)
