@@ -44,6 +44,7 @@ from gimbal.messages.motion import (
     SPEED_TAKE_CONTROL,
     SpeedControl,
 )
+from gimbal.other_hosts import OtherHosts
 from gimbal.packet import REPLY_OPTIONAL
 from gimbal.pushes import PushCallback, PushHub
 from gimbal.transport import (
@@ -106,12 +107,14 @@ class _BusWatch(can.Listener):
 class _Taps(can.Listener):
     """The listeners that want every frame as the bus saw it (a CAN log). On a bus that loops our
     own frames back marked as received (udp_multicast) those echoes are left out: the taps got
-    each of our frames at send already. Once the client closes (``close_at_packet_end``) they get
+    each of our frames at send already. Any other frame on our transmit id is another host's and
+    also goes to ``other_hosts``. Once the client closes (``close_at_packet_end``) they get
     frames until the gimbal's stream is between two packets, so a log never ends with half of one
     that the client did not read either."""
 
-    def __init__(self, transport: CanTransport) -> None:
+    def __init__(self, transport: CanTransport, other_hosts: OtherHosts) -> None:
         self.listeners: list[can.Listener] = []
+        self.other_hosts = other_hosts
         self._transport = transport
         self._gimbal_stream = PacketFramer()  # where the gimbal's packets start and end
         self._closing = False
@@ -121,7 +124,10 @@ class _Taps(can.Listener):
         self._closing = True
 
     def on_message_received(self, msg: can.Message) -> None:
-        if not self.listeners or self._closed or self._transport.take_echo(msg):
+        if self._closed or self._transport.take_echo(msg):
+            return
+        self.other_hosts.on_message_received(msg)
+        if not self.listeners:
             return
         if is_packet_frame(msg, self._transport.rx_id):
             if self._closing and not self._gimbal_stream.pending:
@@ -177,7 +183,8 @@ class GimbalSession:
         self._stops_only = False  # set by close(): other threads' commands must not follow its stop
         self._streamer: SpeedStreamer | None = None
         self._watch = _BusWatch(self._on_receive_error)
-        self._taps = _Taps(self.transport)
+        self.other_hosts = OtherHosts(tx_id)
+        self._taps = _Taps(self.transport, self.other_hosts)
         for listener in listeners:
             self._tap(listener)
         try:
