@@ -5,6 +5,7 @@ import argparse
 import json
 import math
 import sys
+import time
 from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
@@ -12,10 +13,12 @@ from typing import Any
 from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
+from gimbal.watchdog import DEFAULT_TIMEOUT_S, DEGRADED_SILENCE_S
 from gimbal.signals import SignalExit, deferred_signals
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
+from pipelines.cli.sim_faults import parse_sim_faults
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
@@ -26,6 +29,9 @@ from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
 
 DEFAULT_DETECTOR = "motion"
+LISTEN_S = 0.5  # before taking control: another controller streams at 4 Hz at the least (two commands a 0.5 s)
+EXIT_DEGRADED_LINK = 3
+EXIT_OTHER_CONTROLLER = 4
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -40,8 +46,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "  gimbaltrack track udp://127.0.0.1:5000 --detect person\n"
         "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n\n"
         "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png\n"
-        "exit status: 0 done; 1 the gimbal, bus, source or an output failed mid-run; 2 bad input;\n"
-        "  130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to stop in every case)",
+        "exit status: 0 done; 3 done, but the gimbal link was degraded (replies missing, the gimbal\n"
+        "  released for silence) or another controller was seen; 4 another controller drives the gimbal\n"
+        "  (nothing taken over; --shared-bus to run anyway); 1 the bus, source or an output failed\n"
+        "  mid-run; 2 bad input; 130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to\n"
+        "  stop in every case)",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("source", help="video file, image folder, camera index (e.g. 0) or stream URL "
                         "(udp://, rtsp://, http://)")
@@ -98,6 +107,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--quiet", action="store_true", help="no progress line")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_bus_options(parser, default_interface="sim")
+    link = parser.add_argument_group("gimbal link")
+    link.add_argument("--bus-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S",
+                      help=f"release the gimbal after this long without a reply, and take it back when it "
+                      f"answers (default: {DEFAULT_TIMEOUT_S:g}; above {DEGRADED_SILENCE_S:g}); tracking and "
+                      "the outputs go on meanwhile")
+    link.add_argument("--shared-bus", action="store_true",
+                      help="run even if another host is driving this gimbal (by default track listens "
+                      f"{LISTEN_S:g} s first and refuses, exit 4)")
+    link.add_argument("--sim-faults", type=parse_sim_faults, metavar="KEY=VALUE,...",
+                      help="faults of the built-in simulated gimbal (-i sim), as gimbaltrack sim's options: "
+                      "drop, corrupt, fault-direction, delay-ms, nack, silent (START:END s), seed; "
+                      "e.g. drop=0.2 or silent=6:6.3")
     add_legacy_order_option(parser)
     parser.set_defaults(func=run_track)
 
@@ -120,6 +141,11 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError(f"--hfov takes 0 < DEG < 180, not {args.hfov:g}")
     if args.max_frames is not None and args.max_frames < 1:
         raise CliError("--max-frames must be at least 1")
+    if not DEGRADED_SILENCE_S < args.bus_timeout < math.inf:
+        raise CliError(f"--bus-timeout takes a finite time above {DEGRADED_SILENCE_S:g} s (a shorter silence "
+                       f"only degrades the link), not {args.bus_timeout:g}")
+    if args.sim_faults is not None and args.interface != SIM_INTERFACE:
+        raise CliError("--sim-faults is for the built-in simulated gimbal (-i sim)")
     detect = args.detect or (None if roi else DEFAULT_DETECTOR)
     return TrackOptions(
         out_dir=args.out, roi=roi, detect=detect,
@@ -169,6 +195,8 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                     where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
                              " ".join(str(v) for v in (args.interface or "python-can's configured bus",
                                                        args.channel) if v))
+                    if not (args.shared_bus or args.interface == SIM_INTERFACE):
+                        _refuse_a_second_controller(client, where)
                     try:
                         session = _session(options, source, client, where, subject, can_log, held)
                     except CliError:  # it says why the run ended; a signal held meanwhile adds nothing
@@ -177,6 +205,16 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                     return _run(session, args)
             finally:
                 can_log.stop()
+
+
+def _refuse_a_second_controller(client: GimbalClient, where: str) -> None:
+    """Listen ``LISTEN_S`` before taking control: another host's speed or control commands on our
+    transmit id mean someone drives this gimbal already, and two controllers fight over it."""
+    if client.other_hosts.wait_for_control(LISTEN_S):
+        time.sleep(min(LISTEN_S, 0.1))  # a few more of its commands, to name what it sends
+        raise CliError(f"another host is driving the gimbal on {where}: it sent "
+                       f"{client.other_hosts.seen().describe()} on 0x{client.transport.tx_id:03X}; "
+                       "stop it first, or pass --shared-bus to run anyway", exit_code=EXIT_OTHER_CONTROLLER)
 
 
 def _can_log(path: Path) -> CanLogWriter:
