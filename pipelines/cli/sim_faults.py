@@ -2,12 +2,12 @@
 as one option, so that a run against a flaky link is one command (and a fast test)."""
 from __future__ import annotations
 
+import argparse
 from collections.abc import Callable
 from typing import Any
 
 from gimbal.sim import Faults
 from gimbal.sim.checks import FieldError
-from pipelines.cli.common import CliError
 
 #: key in the spec: (Faults field, parse); the keys are ``gimbaltrack sim``'s option names.
 KEYS: dict[str, tuple[str, Callable[[str], Any]]] = {
@@ -20,24 +20,24 @@ KEYS: dict[str, tuple[str, Callable[[str], Any]]] = {
                else float("nan")),
     "seed": ("seed", int),
 }
-USAGE = ("--sim-faults takes KEY=VALUE[,KEY=VALUE...] with keys " + ", ".join(KEYS)
+USAGE = ("takes KEY=VALUE[,KEY=VALUE...] with keys " + ", ".join(KEYS)
          + " (as gimbaltrack sim's options), e.g. drop=0.2,silent=6:6.3")
 
 
 def parse_sim_faults(spec: str) -> Faults:
-    """``drop=0.2,silent=6:6.3`` as ``Faults``; a one-line ``CliError`` (exit 2) otherwise."""
+    """``drop=0.2,silent=6:6.3`` as ``Faults``; ``argparse.ArgumentTypeError`` (one line, exit 2) otherwise."""
     fields: dict[str, Any] = {}
     for item in spec.split(","):
         key, sep, text = item.strip().partition("=")
         if not sep or key not in KEYS:
-            raise CliError(f"{USAGE}, not {item.strip()!r}")
+            raise argparse.ArgumentTypeError(f"{USAGE}, not {item.strip()!r}")
         field, parse = KEYS[key]
         try:
             fields[field] = parse(text)
         except ValueError:
-            raise CliError(f"--sim-faults {key} takes a number, not {text!r}") from None
+            raise argparse.ArgumentTypeError(f"{key} takes a number, not {text!r}") from None
     try:
         return Faults(**fields)
     except FieldError as exc:
         key = next(k for k, (field, _) in KEYS.items() if field == exc.field)
-        raise CliError(f"--sim-faults {key} takes {exc.takes}") from None
+        raise argparse.ArgumentTypeError(f"{key} takes {exc.takes}") from None
