@@ -33,8 +33,9 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
 from pipelines.cli.bus import open_host_bus
-from pipelines.cli.common import (CliError, add_bus_options, hold_on_devnull, parse_int, parse_seconds,
+from pipelines.cli.common import (CliError, add_bus_options, parse_int, parse_seconds,
                                   suppress_defaults)
+from pipelines.cli.process import hold_on_devnull
 
 Result = dict[str, Any]
 LIMITS = tuple(LIMIT_RANGES)

@@ -11,19 +11,21 @@ import queue
 import time
 from collections.abc import Callable
 from concurrent.futures import Future
-from typing import Any, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 import numpy as np
 
-from pipelines.control.controller import Controller
 from pipelines.control.gimbal_link import GimbalLink
 from pipelines.loop.record import FrameRecord
 from pipelines.loop.recording import Recorder
 from pipelines.loop.sinks import Sink
-from pipelines.sources import Frame
-from tracker.boxes import Box
-from tracker.detectors import Detection
-from tracker.estimate import TargetEstimate
+
+if TYPE_CHECKING:
+    from pipelines.control.controller import Controller
+    from pipelines.sources import Frame
+    from tracker.boxes import Box
+    from tracker.detectors import Detection
+    from tracker.estimate import TargetEstimate
 
 T = TypeVar("T")
 

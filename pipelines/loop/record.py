@@ -3,11 +3,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from pipelines.control.attitude import Attitude
-from pipelines.control.controller import RateCommand
-from tracker.detectors import Detection
-from tracker.estimate import TargetEstimate
+if TYPE_CHECKING:
+    from pipelines.control.attitude import Attitude
+    from pipelines.control.controller import RateCommand
+    from tracker.detectors import Detection
+    from tracker.estimate import TargetEstimate
 
 #: ``FrameRecord.state`` before the subject is chosen (no estimate yet).
 ACQUIRING = "acquiring"

@@ -10,10 +10,12 @@ import time
 from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Protocol, TYPE_CHECKING
 
 from pipelines.loop.record import FrameRecord
-from pipelines.sources import Frame
+
+if TYPE_CHECKING:
+    from pipelines.sources import Frame
 
 
 class Sink(Protocol):
