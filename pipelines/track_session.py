@@ -130,7 +130,7 @@ class TrackSession:
         self.loop = Loop(self.subject, make_controller(options.controller, camera=self.camera,
                                                        config=control_config(options.max_speed_dps)),
                          self.link, feedback=self.feedback, recorder=self.recorder,
-                         video_fps=None if source.is_live else source.nominal_fps,
+                         video_fps=None if source.is_live else source.playback_fps,
                          dropped=lambda: source.dropped)
         # live and realtime frames carry monotonic capture times; fast file playback stamps on read
         self._monotonic_stamps = source.is_live or options.realtime
@@ -148,7 +148,7 @@ class TrackSession:
         self.plot = self.loop.attach(PlotSink(self.paths["plot"]))
         if options.video:
             self.paths["video"] = out / "annotated.avi"
-            self.outputs.append(self.loop.attach(VideoSink(self.paths["video"], source.size, source.nominal_fps,
+            self.outputs.append(self.loop.attach(VideoSink(self.paths["video"], source.size, source.playback_fps,
                                                            options.video_width)))
         if can_log is not None:
             self.loop.attach(_CanLogCheck(can_log))
@@ -243,7 +243,7 @@ class TrackSession:
             "bus": self.bus_description, "tracker": self.subject.name, "controller": self.options.controller,
             "attitude_feedback": self.feedback,
             "frames": counts.frames, "elapsed_s": elapsed, "fps": counts.frames / elapsed if elapsed > 0 else None,
-            "frames_dropped": self.source.dropped,
+            "frames_dropped": counts.dropped,
             "frames_expected": None if self.source.is_live else self.source.frame_count,
             "states": dict(counts.states), "first_acquired_s": self.loop.first_acquired_s,
             "angular_error_deg": counts.angular_error(),

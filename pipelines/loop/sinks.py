@@ -153,6 +153,7 @@ class SummarySink:
         self._clock = clock
         self._last_written = -math.inf
         self.frames = 0
+        self.dropped = 0  # what the source had dropped by the last frame (not what it drops after the run)
         self.states: Counter[str] = Counter()
         self.error_frames = 0  # frames whose command had a subject to measure the error against
         self.error_sum = 0.0
@@ -160,6 +161,7 @@ class SummarySink:
 
     def on_frame(self, record: FrameRecord, frame: Frame) -> None:
         self.frames += 1
+        self.dropped = record.dropped
         self.states[record.state] += 1
         error = record.angular_error_deg
         if error is not None:

@@ -54,7 +54,7 @@ class FrameSource(ABC):
         return self._fps
 
     @property
-    def nominal_fps(self) -> float:
+    def playback_fps(self) -> float:
         """``fps``, or the rate assumed for a source that does not tell its own."""
         return self._fps or ASSUMED_FPS
 
