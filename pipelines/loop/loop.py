@@ -13,15 +13,15 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
-import numpy as np
-
-from pipelines.control.gimbal_link import GimbalLink
 from pipelines.loop.record import FrameRecord
-from pipelines.loop.recording import Recorder
-from pipelines.loop.sinks import Sink
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from pipelines.control.controller import Controller
+    from pipelines.control.gimbal_link import GimbalLink
+    from pipelines.loop.recording import Recorder
+    from pipelines.loop.sinks import Sink
     from pipelines.sources import Frame
     from tracker.boxes import Box
     from tracker.detectors import Detection
