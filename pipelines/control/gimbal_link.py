@@ -11,8 +11,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from gimbal.client import DEFAULT_MAX_AGE_S
-from gimbal.messages.motion import from_raw
+from gimbal.keepalive import DEFAULT_MAX_AGE_S
+from gimbal.messages.limits import MAX_SPEED_DPS
 from gimbal.messages.telemetry import ParameterPush
 from pipelines.control.attitude import Attitude, AttitudeHistory
 
@@ -23,6 +23,8 @@ if TYPE_CHECKING:
 
 #: The keep-alive streams zero once a setpoint is this old (the controller restarts from rest then).
 SETPOINT_MAX_AGE_S = DEFAULT_MAX_AGE_S
+#: The document's speed command range, ± this many °/s (every setpoint is clamped into it).
+PROTOCOL_MAX_SPEED_DPS = MAX_SPEED_DPS
 
 
 @dataclass(frozen=True)
@@ -68,9 +70,10 @@ class GimbalLink:
         self._streamer = self.client.speed_streamer(rate_hz=self.rate_hz)
 
     def on_push(self, msg: ParameterPush, t: float) -> None:
-        """Record a push's attitude, in degrees; a push without valid angles is skipped."""
-        if msg.angles_valid:
-            self.history.add(t, from_raw(msg.yaw_angle), from_raw(msg.roll_angle), from_raw(msg.pitch_angle))
+        """Record a push's attitude (degrees, as the push gives it); one without valid angles is skipped."""
+        attitude = msg.attitude
+        if attitude is not None:
+            self.history.add(t, attitude.yaw, attitude.roll, attitude.pitch)
 
     def attitude_at(self, t: float) -> tuple[float, float] | None:
         """The (yaw, pitch) at time ``t`` in this project's convention (yaw positive to the right,
