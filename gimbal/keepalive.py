@@ -149,6 +149,7 @@ class SpeedStreamer:
         self._wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join()
+        self.watchdog.close()
         if first:
             self._client.stop_and_release()
 
@@ -160,6 +161,7 @@ class SpeedStreamer:
         self._wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join(timeout=2.0)
+        self.watchdog.close()
 
     def _run(self) -> None:
         period = 1.0 / self.rate_hz

@@ -79,12 +79,13 @@ class BusWatchdog:
         self._counts = dict.fromkeys(("unanswered", "late", "timeouts", "nacks", "episodes", "disengagements"), 0)
         self._unreachable_s = 0.0
         self._silence_counted = False  # the current silence is long enough to count as unreachable
+        self._closed_at: float | None = None
 
     # -- events (the keep-alive's thread) --------------------------------------------------
     def replied(self, *, late: bool = False, nack: bool = False) -> None:
         """The gimbal answered a command (``late``: after its window; ``nack``: refused it)."""
         with self._lock:
-            now = self._clock()
+            now = self._now()
             if late:
                 self._counts["late"] += 1
             if nack:
@@ -97,25 +98,36 @@ class BusWatchdog:
         """A command was not answered within its window (it may still be, late)."""
         with self._lock:
             self._counts["timeouts"] += 1
-            self._judge(self._clock())
+            self._judge(self._now())
 
     def unanswered(self) -> None:
         """A command was given up for good: no reply, not even late."""
         with self._lock:
             self._counts["unanswered"] += 1
             self._outcomes.append(False)
+            self._judge(self._now())
+
+    def close(self) -> None:
+        """No more commands (streaming stopped): the state and figures stay as they are now,
+        since a silence after the last command says nothing about the link."""
+        with self._lock:
             self._judge(self._clock())
+            if self._closed_at is None:
+                self._closed_at = self._clock()
 
     # -- reading -------------------------------------------------------------------------
+    def _now(self) -> float:
+        return self._clock() if self._closed_at is None else self._closed_at
+
     def poll(self) -> str:
         """The state now (silence is judged against the clock)."""
         with self._lock:
-            self._judge(self._clock())
+            self._judge(self._now())
             return self._state
 
     def snapshot(self) -> BusHealth:
         with self._lock:
-            now = self._clock()
+            now = self._now()
             self._judge(now)
             ongoing = now - self._last_heard if self._silence_counted else 0.0
             return BusHealth(self._state, self._since, unreachable_s=self._unreachable_s + ongoing,

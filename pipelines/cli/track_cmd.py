@@ -19,6 +19,7 @@ from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.sim_faults import parse_sim_faults
+from pipelines.loop.link import link_degraded, link_report
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
@@ -157,6 +158,7 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         yaw_attitude_sign=-1 if args.invert_yaw_attitude else 1,
         pitch_attitude_sign=-1 if args.invert_pitch_attitude else 1,
         max_frames=args.max_frames, video=not args.no_video, video_width=args.video_width or None,
+        bus_timeout=args.bus_timeout,
         progress=not args.quiet)
 
 
@@ -272,7 +274,7 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
     if summary["status"] == "output failed":  # an output that could not be finalised (a full disk)
         raise _stopped_with(summary["error"], session)
     _report(summary, args)
-    return 0
+    return EXIT_DEGRADED_LINK if link_degraded(summary["bus_health"]) else 0
 
 
 def _stopped_with(error: object, session: TrackSession) -> CliError:
@@ -306,6 +308,7 @@ def _report(summary: dict[str, Any], args: argparse.Namespace) -> None:
                      f"p95 {latency['p95']:.1f} ms, p99 {latency['p99']:.1f} ms")
     if summary["recording"]["requested"]:
         lines.append(f"recording: {_recording_text(summary['recording'])}")
+    lines.append(link_report(summary["bus_health"], summary["speed_commands"].get("sent", 0)))
     lines.append(f"outputs: {Path(summary['outputs']['summary']).parent}")
     print("\n".join(lines), file=sys.stdout)
 

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from gimbal.other_hosts import OtherHostsSeen
+    from gimbal.watchdog import BusHealth
     from pipelines.control.attitude import Attitude
     from pipelines.control.controller import RateCommand
     from tracker.detectors import Detection
@@ -32,6 +34,8 @@ class FrameRecord:
     dropped: int  # frames the source has dropped so far
     recording: bool  # the camera was recording (a start was answered and no stop yet)
     candidates: tuple[Detection, ...] = ()  # the detector's candidates of this frame, if it ran
+    bus: BusHealth | None = None  # the gimbal link's state after this frame's command (None: not streaming)
+    other_hosts: OtherHostsSeen | None = None  # what other hosts sent to the gimbal so far
 
     @property
     def state(self) -> str:

@@ -42,6 +42,10 @@ def telemetry_record(record: FrameRecord) -> dict[str, Any]:
                  "attitude_deg": None if attitude is None else [attitude.yaw, attitude.pitch, attitude.roll],
                  "attitude_t": None if attitude is None else attitude.timestamp,
                  "dropped": record.dropped})
+    if record.bus is not None:
+        line["bus"] = record.bus.as_dict()
+    if record.other_hosts is not None:
+        line["other_hosts"] = record.other_hosts.control
     return line
 
 

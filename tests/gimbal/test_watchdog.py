@@ -116,3 +116,14 @@ def test_the_snapshot_is_plain_data(clock: FakeClock) -> None:
 def test_a_timeout_at_or_below_the_degraded_silence_is_refused() -> None:
     with pytest.raises(ValueError, match="bus timeout"):
         BusWatchdog(0.3)
+
+
+def test_once_closed_the_silence_after_the_last_command_is_not_judged(clock: FakeClock) -> None:
+    """The track summary is written after the stop, video and plot: seconds without commands
+    once read as a silent gimbal released (unreachable 5.1 s on a clean demo run)."""
+    dog = BusWatchdog(clock=clock)
+    ticks(dog, clock, 25, answered=True)
+    dog.close()
+    clock.advance(10.0)
+    health = dog.snapshot()
+    assert (health.state, health.episodes, health.unreachable_s) == (ENGAGED, 0, 0.0)
