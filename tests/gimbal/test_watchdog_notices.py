@@ -52,3 +52,36 @@ def test_report_lines_and_exit_status() -> None:
     shared = link_health(health(), OtherHostsSeen(3, 2, 1.0, {"speed_control": 2, "get_angles": 1}))
     assert link_degraded(shared)
     assert link_report(shared, 10).endswith("; another host sent 2 speed_control, 1 get_angles")
+
+
+class Camera:
+    """What the Recorder uses of a client: record start/stop and the camera's status."""
+
+    def __init__(self) -> None:
+        self.recording = False
+        self.starts = 0
+
+    def start_recording(self) -> None:
+        self.recording, self.starts = True, self.starts + 1
+
+    def stop_recording(self) -> None:
+        self.recording = False
+
+    def camera_status(self) -> bool:
+        return self.recording
+
+
+def test_taking_the_gimbal_back_restarts_a_recording_the_camera_stopped() -> None:
+    from pipelines.loop.recording import Recorder
+
+    camera = Camera()
+    recorder = Recorder(camera, requested=True)  # type: ignore[arg-type]
+    recorder.on_acquired()
+    recorder.restore()  # still recording: nothing sent
+    assert camera.starts == 1 and "restarts" not in recorder.status
+    camera.recording = False  # the gimbal was power-cycled while silent
+    recorder.restore()
+    assert camera.starts == 2 and recorder.status["restarts"] == 1 and recorder.status["start_confirmed"]
+    recorder.stop()
+    recorder.restore()  # stopped on purpose: left stopped
+    assert camera.starts == 2

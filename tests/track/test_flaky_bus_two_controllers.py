@@ -2,6 +2,7 @@
 their setpoints, with no word without -v. A newcomer now listens first and refuses (exit 4)."""
 from __future__ import annotations
 
+import json
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
@@ -12,7 +13,8 @@ import pytest
 from gimbal.client import GimbalClient
 from gimbal.sim import SimConfig, SimulatedGimbal
 from gimbal.transport import HOST_TX_ID
-from pipelines.cli.track_cmd import EXIT_OTHER_CONTROLLER
+from pipelines.cli.track_cmd import EXIT_DEGRADED_LINK, EXIT_OTHER_CONTROLLER
+from pipelines.outputs.telemetry import read_telemetry
 from tests.track.helpers import DEMO, DEMO_ROI, run_track
 
 
@@ -42,3 +44,20 @@ def test_a_newcomer_refuses_to_take_over_a_gimbal_another_host_drives(
     state = sim.state()
     assert state.speed_control and state.speeds[0] == pytest.approx(5.0)
     assert [f for f in can.LogReader(str(out / "can.log")) if f.arbitration_id == HOST_TX_ID]  # what it saw is logged
+
+
+def test_with_shared_bus_it_runs_and_says_once_that_another_host_drives(
+        tmp_path: Path, driven_gimbal: tuple[str, SimulatedGimbal], capsys: pytest.CaptureFixture[str]) -> None:
+    channel, _ = driven_gimbal
+    out = tmp_path / "out"
+    code = run_track(DEMO, out, "--roi", DEMO_ROI, "--max-frames", "30", "--no-video", "-i", "virtual",
+                     "-c", channel, "--shared-bus")
+    captured = capsys.readouterr()
+    assert code == EXIT_DEGRADED_LINK
+    said = [line for line in captured.err.splitlines() if "another host is driving this gimbal too" in line]
+    assert len(said) == 1 and "speed_control" in said[0]
+    assert "another host sent" in captured.out
+    telemetry = read_telemetry(out / "telemetry.jsonl")
+    assert len(telemetry) == 30 and telemetry[-1]["other_hosts"] > 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["bus_health"]["other_hosts"]["control"] > 0
