@@ -2,7 +2,8 @@
 by the keep-alive, read by the loop, the console and ``gimbaltrack doctor``.
 
 States: ``engaged`` (replies come back), ``degraded`` (replies missing: the keep-alive goes on
-streaming, the run goes on tracking), ``disengaged`` (nothing heard for ``timeout_s``: the
+streaming, the run goes on tracking; for ``MIN_DEGRADED_S`` at least, so that the commands of a
+short silence, judged unanswered only later, do not make a second episode), ``disengaged`` (nothing heard for ``timeout_s``: the
 keep-alive sends zero and releases control, then only probes), and back to ``degraded`` (then
 ``engaged``) as soon as the gimbal answers again. A late reply, a NACK and a reply in time all
 show that the gimbal hears us; only a command never answered counts against the link.
@@ -25,6 +26,7 @@ DEFAULT_TIMEOUT_S = 3.0  # silence before the gimbal is released (--bus-timeout)
 DEGRADED_SILENCE_S = 0.3  # nothing heard for this long: degraded (above a 150 ms reply delay)
 WINDOW = 25  # the latest outcomes judged (1 s of the keep-alive at 25 Hz)
 DEGRADED_MISSES = 2  # unanswered commands among them that make the link degraded
+MIN_DEGRADED_S = 1.0  # at least this long degraded: a command counts as unanswered only 0.5 s after it
 
 
 @dataclass(frozen=True)
@@ -157,7 +159,7 @@ class BusWatchdog:
         bad = silence >= self.degraded_silence_s or misses >= self.degraded_misses
         if bad and self._state == ENGAGED:
             self._enter(DEGRADED, now)
-        elif self._state == DEGRADED and not bad and misses == 0:
+        elif self._state == DEGRADED and not bad and misses == 0 and now - self._since >= MIN_DEGRADED_S:
             self._enter(ENGAGED, now)
 
     def _enter(self, state: str, now: float) -> None:

@@ -32,8 +32,8 @@ class LinkNotices:
         """Say what is new since the last call; True when the gimbal was just taken back."""
         taken_back = self._state == DISENGAGED and health.state != DISENGAGED
         if health.episodes > self._episodes:
-            self._say(f"frame {frame}: the gimbal's replies are missing ({health.unanswered} speed commands "
-                      "unanswered so far); tracking and streaming go on")
+            self._say(f"frame {frame}: the gimbal's replies are missing ({health.timeouts - health.late} speed "
+                      "commands without a reply so far); tracking and streaming go on")
         if health.disengagements > self._disengagements:
             self._say(f"frame {frame}: no reply for {self.timeout_s:g} s: the gimbal is stopped and released; "
                       "tracking and the outputs go on, and control is taken back when it answers")

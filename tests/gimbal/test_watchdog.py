@@ -61,6 +61,23 @@ def test_degraded_until_a_whole_window_is_answered(clock: FakeClock) -> None:
     assert dog.poll() == ENGAGED
 
 
+def test_a_short_silence_is_one_episode_though_its_commands_are_judged_later(clock: FakeClock) -> None:
+    """0.3 s without replies degrades at once; the commands of that silence are given up only
+    0.5 s after they were sent, by when the replies are back: still the same episode."""
+    dog = BusWatchdog(clock=clock)
+    ticks(dog, clock, 25, answered=True)
+    for _ in range(8):  # 0.32 s: timed out, not yet given up
+        clock.advance(0.04)
+        dog.timed_out()
+    assert dog.poll() == DEGRADED
+    ticks(dog, clock, 5, answered=True)  # replies again; the silent ones not judged yet
+    for _ in range(8):
+        dog.unanswered()
+    ticks(dog, clock, 40, answered=True)
+    assert dog.poll() == ENGAGED
+    assert dog.snapshot().episodes == 1
+
+
 def test_a_short_silence_degrades_at_once_and_counts_as_unreachable(clock: FakeClock) -> None:
     dog = BusWatchdog(clock=clock)
     ticks(dog, clock, 10, answered=True)

@@ -25,7 +25,7 @@ def test_each_episode_is_said_once_and_the_return_is_said_with_a_restore() -> No
     assert not notices.update(health(ENGAGED, 1, 1, unanswered=95), NOBODY, 180)
     assert not notices.update(health(DEGRADED, 2, 1, unanswered=97), NOBODY, 200)
     assert [line.split(":")[0] for line in said] == ["frame 2", "frame 90", "frame 150", "frame 200"]
-    assert "3 speed commands unanswered" in said[0]
+    assert "3 speed commands without a reply" in said[0]
     assert "no reply for 3 s: the gimbal is stopped and released" in said[1]
     assert "taken back" in said[2]
 
