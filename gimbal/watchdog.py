@@ -23,7 +23,8 @@ DISENGAGED = "disengaged"
 STATES = (ENGAGED, DEGRADED, DISENGAGED)
 
 DEFAULT_TIMEOUT_S = 3.0  # silence before the gimbal is released (--bus-timeout)
-DEGRADED_SILENCE_S = 0.3  # nothing heard for this long: degraded (above a 150 ms reply delay)
+DEGRADED_SILENCE_S = 0.5  # a command waiting this long for a reply: degraded (one command's validity)
+UNREACHABLE_AFTER_S = 0.2  # a wait this long counts in ``unreachable_s``
 WINDOW = 25  # the latest outcomes judged (1 s of the keep-alive at 25 Hz)
 DEGRADED_MISSES = 2  # unanswered commands among them that make the link degraded
 MIN_DEGRADED_S = 1.0  # at least this long degraded: a command counts as unanswered only 0.5 s after it
@@ -34,8 +35,8 @@ class BusHealth:
     """A read-only view of the link. ``since``: when the current state began (the watchdog's clock,
     ``time.monotonic()`` by default); ``unanswered``: speed commands never answered; ``late``:
     answered after their window; ``timeouts``: not answered within their window (late or never);
-    ``nacks``: refused by the gimbal; ``unreachable_s``: time without a reply in stretches long
-    enough to be degraded, the current one included; ``episodes``: times the link left
+    ``nacks``: refused by the gimbal; ``unreachable_s``: time commands waited for a reply in
+    stretches of ``UNREACHABLE_AFTER_S`` or more, the current one included; ``episodes``: times the link left
     ``engaged``; ``disengagements``: times the gimbal was released for silence."""
 
     state: str
@@ -76,7 +77,7 @@ class BusWatchdog:
         now = clock()
         self._state = ENGAGED
         self._since = now
-        self._last_heard = now
+        self._waiting_since: float | None = None  # the first command not answered in time since the last reply
         self._outcomes: deque[bool] = deque(maxlen=window)  # True: heard, False: never answered
         self._counts = dict.fromkeys(("unanswered", "late", "timeouts", "nacks", "episodes", "disengagements"), 0)
         self._unreachable_s = 0.0
@@ -100,14 +101,14 @@ class BusWatchdog:
         """A command was not answered within its window (it may still be, late)."""
         with self._lock:
             self._counts["timeouts"] += 1
-            self._judge(self._now())
+            self._wait(self._now())
 
     def unanswered(self) -> None:
         """A command was given up for good: no reply, not even late."""
         with self._lock:
             self._counts["unanswered"] += 1
             self._outcomes.append(False)
-            self._judge(self._now())
+            self._wait(self._now())
 
     def close(self) -> None:
         """No more commands (streaming stopped): the state and figures stay as they are now,
@@ -131,22 +132,29 @@ class BusWatchdog:
         with self._lock:
             now = self._now()
             self._judge(now)
-            ongoing = now - self._last_heard if self._silence_counted else 0.0
+            ongoing = now - self._waiting_since if self._silence_counted and self._waiting_since is not None else 0.0
             return BusHealth(self._state, self._since, unreachable_s=self._unreachable_s + ongoing,
                              **self._counts)
 
     # -- the machine (lock held) ------------------------------------------------------------
+    def _wait(self, now: float) -> None:
+        """A command without its reply: the silence runs from the first one (a keep-alive that
+        itself stalled, sending nothing, is not a silent gimbal)."""
+        if self._waiting_since is None:
+            self._waiting_since = now
+        self._judge(now)
+
     def _end_silence(self, now: float) -> None:
-        if self._silence_counted:
-            self._unreachable_s += now - self._last_heard
-            self._silence_counted = False
-        self._last_heard = now
+        if self._silence_counted and self._waiting_since is not None:
+            self._unreachable_s += now - self._waiting_since
+        self._silence_counted = False
+        self._waiting_since = None
         if self._state == DISENGAGED:  # the gimbal answers again: take control back, still degraded
             self._enter(DEGRADED, now)
 
     def _judge(self, now: float) -> None:
-        silence = now - self._last_heard
-        if silence >= self.degraded_silence_s:
+        silence = 0.0 if self._waiting_since is None else now - self._waiting_since
+        if silence >= UNREACHABLE_AFTER_S:
             self._silence_counted = True
         if silence >= self.timeout_s:
             if self._state != DISENGAGED:

@@ -11,7 +11,7 @@ from tests.track.helpers import DEMO, DEMO_ROI, run_track
 
 
 @pytest.mark.parametrize(("extra", "words"), [
-    (("--bus-timeout", "0.2"), "--bus-timeout takes a finite time above 0.3 s"),
+    (("--bus-timeout", "0.5"), "--bus-timeout takes a finite time above 0.5 s"),
     (("--bus-timeout", "nan"), "--bus-timeout takes"),
     (("--sim-faults", "drop=2"), "drop takes a fraction from 0 to 1"),
     (("--sim-faults", "loss=0.2"), "takes KEY=VALUE"),
