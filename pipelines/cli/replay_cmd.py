@@ -23,7 +23,7 @@ from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
 from gimbal.transport import CanTransport, packet_frames
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
-from pipelines.cli.decode_cmd import _close, _open_log, check_log_path, iter_log_frames
+from pipelines.cli.log_input import LogFrames, check_log_path, close_reader, open_log
 from pipelines.cli.sim_cmd import status_line
 
 ARROWS = {HOST_TO_GIMBAL: "host->gimbal", None: "?"}
@@ -41,7 +41,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "bus at their recorded times ('-i sim': the built-in simulated gimbal, whose final state is "
         "printed); only whole packets of the document with every value in its range are sent, the "
         "others are counted in the summary. An interrupted replay onto a bus ends with zero speed "
-        "and control released.",
+        "and control released. A log whose last line is cut short (a recorder stopped mid-write) is "
+        "replayed up to it, with a warning; one unreadable part way is summarised up to there, then "
+        "the error (exit 2).",
         epilog="examples:\n  gimbaltrack replay out/track/can.log\n"
         "  gimbaltrack replay out/track/can.log --json | jq .\n"
         "  gimbaltrack replay out/track/can.log -i sim --speed 4\n"
@@ -219,12 +221,15 @@ def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
         raise CliError("-c/--channel and -b/--bitrate need -i/--interface: replay sends onto a bus only with -i")
     check_log_path(args.log)  # before a bus is opened
     summary = ReplaySummary()
+    failure = None
     with _target(args) as (bus, sim):
         started = time.monotonic()
         completed = False
         try:
             _replay(args, summary, bus, out)
             completed = True
+        except CliError as exc:  # a log unreadable part way, a bus refusing: what was replayed is summarised first
+            failure = exc
         finally:
             if bus is not None and summary.frames_sent and (not completed or summary.holds_control):
                 _stop_gimbal(bus, args.tx_id, args.rx_id)
@@ -233,6 +238,8 @@ def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
             _print(out, args.json, {"sim_state": state.as_dict()},
                    "simulated gimbal at the end: " + status_line(state, time.monotonic() - started))
         _print(out, args.json, {"summary": summary.as_dict()}, summary.text())
+    if failure is not None:
+        raise failure
     return 0
 
 
@@ -250,7 +257,7 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
     decoder = LogDecoder(args.tx_id, args.rx_id)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
     skip_echoes = _marks_sent_frames(args.log, args.tx_id)
-    with closing(iter_log_frames(args.log, "replay")) as frames:
+    with closing(LogFrames(args.log, "replay")) as frames:
         for frame in frames:
             if skip_echoes and frame.arbitration_id == args.tx_id and frame.is_rx:
                 summary.echoes += 1
@@ -268,18 +275,19 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
     if bus is not None:  # a host packet left incomplete is counted, never sent
         _send_host_packets(records, bus, args.tx_id, summary)
     _emit(records, summary, args.json, out)
+    frames.check()
 
 
 def _marks_sent_frames(path: str, tx_id: int) -> bool:
     """True when the log marks the host's frames as sent (``T``): then host-id frames marked
     received are the bus's echo of them (udp_multicast loops every frame back) and are skipped."""
-    reader = _open_log(path)
+    reader, _ = open_log(path)
     try:
         return any(f.arbitration_id == tx_id and not f.is_rx for f in reader)
     except Exception:  # noqa: BLE001 - an unreadable log is reported by the replay itself
         return False
     finally:
-        _close(reader)
+        close_reader(reader)
 
 
 def _send(bus: can.BusABC, raw: bytes, tx_id: int) -> int:
