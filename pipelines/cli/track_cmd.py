@@ -14,7 +14,7 @@ from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit, deferred_signals
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
-from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
+from pipelines.cli.bus import choose_track_bus, open_host_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
@@ -31,8 +31,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "track", help="track a subject in video and keep it framed with the gimbal",
         description="Track a subject in a video file, image folder, camera or stream, turn its "
-        "position into yaw/pitch rates (Kalman + PID) and stream them to the gimbal. With no bus "
-        "options the built-in simulated gimbal is used. Outputs (annotated video, telemetry, CAN "
+        "position into yaw/pitch rates (Kalman + PID) and stream them to the gimbal. With no -i, "
+        "python-can's configuration (CAN_INTERFACE, CAN_CHANNEL, CAN_BITRATE, CAN_CONFIG, ~/.canrc) "
+        "picks the bus when it names an interface, else the built-in simulated gimbal is used; a "
+        "line on stderr says which. Outputs (annotated video, telemetry, CAN "
         "log, summary, plot) are written to --out as the run goes.",
         epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
         "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
@@ -94,9 +96,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--video-width", type=int, default=DEFAULT_VIDEO_WIDTH, metavar="PX",
                      help=f"shrink the annotated video to at most this width (default: {DEFAULT_VIDEO_WIDTH}, "
                      "cheap to encode; 0: the source's full size)")
-    run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument("--quiet", action="store_true", help="no progress line, and no line naming the bus "
+                     "chosen without -i (the summary names it)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
-    add_bus_options(parser, default_interface="sim")
+    add_bus_options(parser, fallback="the built-in simulated gimbal")
     parser.set_defaults(func=run_track)
 
 
@@ -155,6 +158,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             subject = make_subject(options)  # missing model files fail before --out is created
         except (ValueError, OSError) as exc:
             raise CliError(str(exc)) from None
+        where, chosen = choose_track_bus(args)
         with open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
@@ -164,14 +168,13 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             try:
                 with LoggingBus(bus, can_log) as logged, \
                         GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id) as client:
-                    where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
-                             " ".join(str(v) for v in (args.interface or "python-can's configured bus",
-                                                       args.channel) if v))
                     try:
                         session = _session(options, source, client, where, subject, can_log, held)
                     except CliError:  # it says why the run ended; a signal held meanwhile adds nothing
                         pending_signals.clear()
                         raise
+                    if chosen and not args.quiet:  # once the gimbal answered: an error before names the bus
+                        print(chosen, file=sys.stderr, flush=True)
                     return _run(session, args)
             finally:
                 can_log.stop()
