@@ -49,6 +49,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def parse_hex(text: str) -> bytes:
     """Bytes from hex text; whitespace, colons, commas and 0x prefixes are ignored."""
     digits = _SEPARATORS.sub("", text)
+    if not digits:
+        raise CliError("--hex: no hex digits in an argument")
     if len(digits) % 2:
         raise CliError(f"--hex: odd number of hex digits ({len(digits)})")
     try:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from collections import Counter
@@ -21,6 +20,7 @@ from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
 from gimbal.messages import message_packet
 from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
 from gimbal.transport import CanTransport, packet_frames
+from gimbal.values import shown
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
 from pipelines.cli.log_input import LogFrames, check_log_path, close_reader, open_log
@@ -29,7 +29,8 @@ from pipelines.cli.sim_cmd import status_line
 ARROWS = {HOST_TO_GIMBAL: "host->gimbal", None: "?"}
 PUSH_KEY_FIELDS = ("yaw_angle", "roll_angle", "pitch_angle")  # a push's other fields rarely change
 STOP_SEQ = 0xFFF0  # SEQs of the safety stop sent after an interrupted replay
-SETTLE_S = 1.0  # how long the simulated gimbal may take to come to rest before its state is shown
+SETTLE_S = 1.0
+SPEED_RANGE = (0.1, 100.0)  # playback factors: a 10-minute log takes 100 min to 6 s  # how long the simulated gimbal may take to come to rest before its state is shown
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -55,7 +56,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--realtime", action="store_true",
                         help="print at the recorded pace (always on when sending onto a bus)")
     parser.add_argument("--speed", type=float, default=1.0, metavar="X",
-                        help="playback speed factor for --realtime and bus output (default 1)")
+                        help=f"playback speed factor for --realtime and bus output, {SPEED_RANGE[0]:g} to "
+                        f"{SPEED_RANGE[1]:g} (default 1)")
     add_bus_options(parser)
     parser.set_defaults(func=run)
 
@@ -215,8 +217,9 @@ def _target(args: argparse.Namespace) -> Iterator[tuple[can.BusABC | None, Any]]
 
 def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
     out = out or sys.stdout
-    if not 0 < args.speed < math.inf:
-        raise CliError(f"--speed takes a finite factor above 0, not {args.speed:g}")
+    low, high = SPEED_RANGE
+    if not low <= args.speed <= high:
+        raise CliError(f"--speed takes a finite factor from {low:g} to {high:g}, not {shown(args.speed)}")
     if args.interface is None and (args.channel is not None or args.bitrate is not None):
         raise CliError("-c/--channel and -b/--bitrate need -i/--interface: replay sends onto a bus only with -i")
     check_log_path(args.log)  # before a bus is opened

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from contextlib import ExitStack
 from pathlib import Path
@@ -13,6 +12,7 @@ from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit, deferred_signals
+from gimbal.values import shown
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
 from pipelines.cli.bus import choose_track_bus, open_host_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
@@ -25,6 +25,7 @@ from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
 
 DEFAULT_DETECTOR = "motion"
+FPS_RANGE = (0.1, 1000.0)  # a frame every 10 s to 1000 a second; the video writer takes these
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -87,7 +88,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run = parser.add_argument_group("run")
     run.add_argument("--realtime", action="store_true", help="play files at their own frame rate")
     run.add_argument("--fps", type=float, help="frame rate of an image folder (default: 30), or a video file's "
-                     "rate overriding its own")
+                     f"rate overriding its own; {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}")
     run.add_argument("--record", action="store_true",
                      help="start camera recording when the subject is acquired, stop it at the end")
     run.add_argument("--max-frames", type=int, help="stop after this many frames")
@@ -115,8 +116,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError(f"--max-speed takes 0 < DEG_S <= {PROTOCOL_MAX_SPEED_DPS:g} (the protocol's limit)")
     if args.video_width < 0 or args.video_width == 1:
         raise CliError("--video-width takes 0 (full size) or at least 2 pixels")
-    if args.fps is not None and not 0 < args.fps < math.inf:
-        raise CliError(f"--fps takes a finite frame rate above 0, not {args.fps:g}")
+    if args.fps is not None and not FPS_RANGE[0] <= args.fps <= FPS_RANGE[1]:
+        raise CliError(f"--fps takes {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} frames a second, not {shown(args.fps)}")
     if args.hfov is not None and not 0 < args.hfov < 180:
         raise CliError(f"--hfov takes 0 < DEG < 180, not {args.hfov:g}")
     if args.max_frames is not None and args.max_frames < 1:

@@ -84,7 +84,7 @@ def test_replay_speed_is_bounded(speed: str, tmp_path: Path, capsys: pytest.Capt
     log = tmp_path / "one.log"
     log.write_text("(0.0) can0 223#AA1A000300000000\n(1000000.0) can0 223#AA1A000300000000\n")
     assert main(["replay", str(log), "--realtime", "--speed", speed]) == 2
-    assert one_line_error(capsys) == (f"gimbaltrack replay: error: --speed takes a factor from 0.1 to 100, "
+    assert one_line_error(capsys) == (f"gimbaltrack replay: error: --speed takes a finite factor from 0.1 to 100, "
                                       f"not {float(speed):g}")
 
 
