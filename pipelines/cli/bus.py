@@ -41,7 +41,8 @@ def open_host_bus(args: argparse.Namespace) -> Iterator[can.BusABC]:
     try:
         yield bus
     finally:
-        bus.shutdown()
+        if not bus._is_shutdown:  # a LoggingBus around it shut it down; slcan's second shutdown raises
+            bus.shutdown()
 
 
 def choose_track_bus(args: argparse.Namespace) -> tuple[str, str | None]:

@@ -23,6 +23,7 @@ from gimbal.transport import CanTransport, packet_frames
 from gimbal.values import shown
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
+from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.log_input import LogFrames, check_log_path, close_reader, open_log
 from pipelines.cli.sim_cmd import status_line
 
@@ -59,6 +60,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help=f"playback speed factor for --realtime and bus output, {SPEED_RANGE[0]:g} to "
                         f"{SPEED_RANGE[1]:g} (default 1)")
     add_bus_options(parser)
+    add_legacy_order_option(parser)
     parser.set_defaults(func=run)
 
 
@@ -257,7 +259,7 @@ def _settled(sim: Any) -> Any:
 
 
 def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | None, out: TextIO) -> None:
-    decoder = LogDecoder(args.tx_id, args.rx_id)
+    decoder = LogDecoder(args.tx_id, args.rx_id, args.legacy_order)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
     skip_echoes = _marks_sent_frames(args.log, args.tx_id)
     with closing(LogFrames(args.log, "replay")) as frames:

@@ -15,6 +15,7 @@ from gimbal.signals import SignalExit, deferred_signals
 from gimbal.values import shown
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
 from pipelines.cli.bus import choose_track_bus, open_host_bus
+from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
@@ -101,6 +102,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      "chosen without -i (the summary names it)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_bus_options(parser, fallback="the built-in simulated gimbal")
+    add_legacy_order_option(parser)
     parser.set_defaults(func=run_track)
 
 
@@ -168,7 +170,8 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             can_log = _can_log(options.out_dir / "can.log")
             try:
                 with LoggingBus(bus, can_log) as logged, \
-                        GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id) as client:
+                        GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id,
+                                     legacy_attitude_order=args.legacy_order) as client:
                     try:
                         session = _session(options, source, client, where, subject, can_log, held)
                     except CliError:  # it says why the run ended; a signal held meanwhile adds nothing

@@ -3,6 +3,7 @@ names an interface, else the built-in simulated gimbal; one stderr line says whi
 configuration is a one-line error, for every command that reads it."""
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import can
@@ -104,3 +105,16 @@ def test_a_broken_configuration_is_one_line(command: list[str], variable: str | 
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and words in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_config_names_the_simulator_as_the_default_bus(no_configuration: Path, channel: str,
+                                                       monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """``gimbaltrack config`` says what ``track`` would drive: the simulator when nothing names a bus."""
+    monkeypatch.chdir(no_configuration)  # no ./gimbaltrack.toml
+    assert main(["config", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["[bus].interface"] == {"value": "sim", "source": "default"}
+    monkeypatch.setenv("CAN_INTERFACE", "virtual")
+    assert main(["config", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["[bus].interface"] == {"value": "virtual",
+                                                                      "source": "python-can configuration"}
