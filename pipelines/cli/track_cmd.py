@@ -146,7 +146,8 @@ def run_track(args: argparse.Namespace) -> int:
 
 def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
     try:
-        source = open_source(args.source, realtime=args.realtime, fps=args.fps)
+        source = open_source(args.source, realtime=args.realtime, fps=args.fps,
+                             waiting=None if args.quiet else _say_waiting)
     except SourceError as exc:
         raise CliError(str(exc)) from None
     with source:
@@ -182,6 +183,11 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                     return _run(session, args)
             finally:
                 can_log.stop()
+
+
+def _say_waiting(description: str) -> None:
+    print(f"gimbaltrack track: waiting for {description}: nothing received yet (Ctrl-C stops)",
+          file=sys.stderr, flush=True)
 
 
 def _can_log(path: Path) -> CanLogWriter:
