@@ -60,13 +60,6 @@ class WholeLines:
         self.last = line
         return line
 
-    def readline(self) -> str:
-        return next(self, "")
-
-    @property
-    def closed(self) -> bool:
-        return self._file.closed
-
     def close(self) -> None:
         self._file.close()
 
