@@ -395,7 +395,6 @@ def test_a_nan_box_is_never_steered_by(name):
 
 
 # What the P baseline's setpoints report besides the speeds: signed errors and latency.
-CAM = CameraModel(640, 360)
 
 
 def test_errors_follow_the_cameras_angle_convention_and_latency_is_now_minus_capture() -> None:
@@ -413,7 +412,6 @@ def test_errors_follow_the_cameras_angle_convention_and_latency_is_now_minus_cap
 
 
 # The PID's integral share of a setpoint is capped by ``integral_limit_dps``.
-CAM = CameraModel(640, 360)
 
 
 def test_a_gimbal_held_at_its_stop_does_not_wind_the_integral_past_its_limit() -> None:
@@ -434,7 +432,6 @@ def test_a_gimbal_held_at_its_stop_does_not_wind_the_integral_past_its_limit() -
 # A NaN control setting, a camera size that is no whole number of pixels, a NaN or infinite
 # focal length, and a controller clock that is not finite or runs backwards are refused by name
 # (they were accepted and later a 'cannot clamp NaN' or a silent zero output, e.g. feedforward=NaN).
-CAM = CameraModel(640, 360)
 ESTIMATE = TargetEstimate(box=(400.0, 200.0, 40.0, 40.0), velocity=(0.0, 0.0), confidence=0.9,
                           state=TrackState.TRACKING, timestamp=0.0, frame_index=1)
 
@@ -490,7 +487,6 @@ def test_the_speed_range_holds_even_when_the_previous_setpoint_was_outside_it() 
 
 
 # A target found again after the controller stopped is filtered and controlled afresh.
-CAM = CameraModel(640, 360)
 
 
 def _seen(x: float, t: float, index: int) -> TargetEstimate:
@@ -513,7 +509,6 @@ def test_a_still_centred_target_found_after_a_loss_is_not_chased_with_the_old_mo
 
 
 # Yaw errors and commands when the gimbal and an off-centre target straddle +-180 deg.
-CAM = CameraModel(640, 360)
 
 
 def test_an_off_centre_target_across_the_wrap_keeps_a_small_error_and_the_same_direction() -> None:
