@@ -170,7 +170,9 @@ class CvNanoNetworks:
 
 class OrtNanoNetworks:
     """NanoTrack v3's two networks on onnxruntime, each checked on loading (``ValueError`` naming a
-    file that is not the network its name says)."""
+    file that is not the network its name says). The backbone file declares 255 px crops, which
+    onnxruntime holds it to, so the 127 px template crop (once per start) goes through ``cv2.dnn``,
+    which runs the same file at any size (equal features to 1e-5 on a 255 px crop)."""
 
     score_size = V3_SCORE_SIZE
 
@@ -184,9 +186,14 @@ class OrtNanoNetworks:
                                   "input2": (1, channels, SEARCH_FEATURES, SEARCH_FEATURES)},
                                  {"output1": (1, 2, *maps), "output2": (1, 4, *maps)}, threads)
         self._template = np.zeros((1, channels, TEMPLATE_FEATURES, TEMPLATE_FEATURES), np.float32)
+        self._template_backbone = _read_network(backbone, "v3 backbone")
+        _backbone_features(self._template_backbone, backbone, EXEMPLAR_SIZE, TEMPLATE_FEATURES)
 
     def features(self, blob: np.ndarray) -> np.ndarray:
-        return self._backbone.run(input=blob)["output"]
+        if blob.shape[2] == INSTANCE_SIZE:
+            return self._backbone.run(input=blob)["output"]
+        self._template_backbone.setInput(blob)
+        return self._template_backbone.forward()
 
     def set_template(self, features: np.ndarray) -> None:
         self._template = features
