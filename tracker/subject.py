@@ -49,9 +49,10 @@ class SubjectTracker:
     after ``lost_after_frames`` misses it reports ``LOST`` and holds the last box.
     """
 
-    def __init__(self, name: str, backend: TrackingBackend,
-                 detector: Detector | None = None, settings: TrackerSettings | None = None) -> None:
+    def __init__(self, name: str, backend: TrackingBackend, detector: Detector | None = None,
+                 settings: TrackerSettings | None = None, model: str | None = None) -> None:
         self.name = name
+        self.model = model  # where the backend's model files came from (None: it has none)
         self._backend = backend
         self._detector = detector
         self.settings = settings or TrackerSettings()

@@ -54,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
-                         "is nanotrack when --model-dir holds its files, else dcf)")
+                         "is nanotrack3 on the model files shipped with gimbaltrack, else dcf)")
     subject.add_argument("--model-dir", type=existing_dir,
                          help="folder with optional model files: NanoTrack (then the default tracker) and "
                          "YuNet (then the face detector)")
