@@ -10,6 +10,7 @@ import logging
 import os
 import signal
 import sys
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -62,6 +63,12 @@ def quiet_opencv(argv: list[str]) -> None:
         os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "8")  # AV_LOG_FATAL
 
 
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                      line: str | None = None) -> str:
+    """A warning (e.g. the default tracker's model could not be loaded) as one line, like the errors."""
+    return f"gimbaltrack: warning: {message}\n"
+
+
 def main(argv: list[str] | None = None, release: Iterable[int] | None = None) -> int:
     """Parse ``argv`` and run the subcommand; its exit status. ``release``: the signal mask to go
     back to once the handlers are in place, when the caller holds the signals already."""
@@ -70,6 +77,7 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     if sys.stderr is None:  # fd 2 closed (2>&-): print(file=None) wrote the errors among the results
         sys.stderr = closed_stderr()
     quiet_opencv(given)
+    warnings.formatwarning = _one_line_warning
     if sys.stdout is None:  # fd 1 closed (>&-): Python gives no stdout, and print() drops the results
         sys.stdout = ClosedStdout()
     try:
