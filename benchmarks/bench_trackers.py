@@ -71,7 +71,9 @@ def main(argv: list[str] | None = None) -> int:
     default_models = shared_data_dir() / "models"
     parser.add_argument("--model-dir", type=Path, default=default_models if default_models.is_dir() else None)
     parser.add_argument("--only", action="append", metavar="LABEL",
-                        help="a label to run, repeatable (the CSRT baseline always runs)")
+                        help="a label to run, repeatable (the baseline always runs)")
+    parser.add_argument("--baseline", default=BASELINE, metavar="LABEL",
+                        help=f"the label the ratios are taken against (default: {BASELINE})")
     parser.add_argument("--starts", action="store_true",
                         help="also track from OTB's perturbed first boxes and print each tracker's mean AUC "
                              "over all starts (steadier than one start)")
@@ -88,13 +90,16 @@ def main(argv: list[str] | None = None) -> int:
         print(f"no sequences under {shared_data_dir() / 'sequences'}", file=sys.stderr)
         return 2
     table = contenders(args.model_dir)
-    labels = [k for k in table if not args.only or k == BASELINE or k in args.only]
+    if args.baseline not in table:
+        print(f"bench_trackers: no tracker labelled {args.baseline!r} (labels: {', '.join(table)})", file=sys.stderr)
+        return 2
+    labels = [k for k in table if not args.only or k == args.baseline or k in args.only]
     results: dict[str, list[SequenceResult]] = {}
     for label in labels:
         print(f"running {label} ...", file=sys.stderr, flush=True)
         results[label] = [run_sequence(table[label](), seq) for seq in sequences]
     hd = [i for i, seq in enumerate(sequences) if _frame_size(seq) == HD]
-    _print_table(results, [s.name for s in sequences], hd)
+    _print_table(results, [s.name for s in sequences], hd, args.baseline)
     _print_against_plain_loops(results)
     if args.starts:
         _print_starts({label: table[label] for label in labels}, sequences, results)
@@ -132,13 +137,15 @@ def _print_starts(table: dict[str, object], sequences: list[Sequence],
         print(f"| {label} | {' | '.join(f'{m:.2f}' for m in means)} | {np.mean(means):.3f} |", flush=True)
 
 
-def _print_table(results: dict[str, list[SequenceResult]], names: list[str], hd: list[int]) -> None:
-    """One row per tracker: AUC per sequence, means, fps (all, and on the 1280x720 sequences ``hd``)."""
+def _print_table(results: dict[str, list[SequenceResult]], names: list[str], hd: list[int], baseline: str) -> None:
+    """One row per tracker: AUC per sequence, means, fps (all, and on the 1280x720 sequences ``hd``),
+    and ratios against ``baseline``."""
     print(describe_machine())
-    base = summarize(results[BASELINE])
+    base = summarize(results[baseline])
     short = [n.split("_", 1)[-1][:8] for n in names]
+    print(f"ratios against: {baseline}")
     print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps | median fps 1280x720 "
-          "| AUC / CSRT | fps / CSRT | median CPU fps | CPU fps / CSRT |")
+          "| AUC ratio | fps ratio | median CPU fps | CPU fps ratio |")
     print("|---" * (len(names) + 9) + "|")
     for label, rows in results.items():
         s = summarize(rows)
