@@ -10,6 +10,7 @@ from tracker.boxes import center
 from tracker.estimate import TrackState
 from tracker.fear import FearBackend, decode_best, grid_points
 from tracker.onnx_sessions import OnnxNetwork
+from tracker.registry import make_tracker
 from tracker.subject import SubjectTracker
 from tracker.vittrack import VitTrackBackend, centred_hann, decode_peak, normalised_blob
 
@@ -159,3 +160,14 @@ def test_grey_and_bgra_frames_are_tracked_too(models, name):
     backend.init(grey, (200.0, 150.0, SIDE, SIDE))
     box, score = backend.update(np.dstack([_frame(208, 150), np.full((360, 480), 255, np.uint8)]))
     assert score > 0.5 and abs(center(box)[0] - 224) <= 5
+
+
+def test_nanotrack3_made_by_name_reports_a_subject_that_leaves_lost(models):
+    """As made by ``make_tracker`` (its confidence from the backend's score alone, under a lower gate)."""
+    subject = make_tracker("nanotrack3", models)
+    subject.init(_frame(200, 150), (200.0, 150.0, SIDE, SIDE), 0.0)
+    present = [subject.update(_frame(200, 150), i / 30) for i in range(1, 10)]
+    absent = [subject.update(_frame(-1, -1), i / 30) for i in range(10, 40)]
+    assert all(e.state is TrackState.TRACKING for e in present)
+    assert TrackState.TRACKING not in {e.state for e in absent}
+    assert absent[-1].state is TrackState.LOST
