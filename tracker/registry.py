@@ -41,8 +41,8 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
 
     ``default`` is ``DEFAULT_MODEL_TRACKER`` on its embedded model files (or on ``model_dir``'s,
     when it holds them); where they cannot be loaded (onnxruntime missing, a damaged file) it is
-    the correlation filter, with a ``ModelFallbackWarning``. Other model trackers read
-    ``model_dir``, or the embedded files where it is not given. Unknown names raise ``ValueError``;
+    the correlation filter, with a ``ModelFallbackWarning``. ``DEFAULT_MODEL_TRACKER`` asked for by
+    name reads the embedded files where ``model_dir`` is not given; other model trackers need it. Unknown names raise ``ValueError``;
     missing model files, or a ``model_dir`` that is no folder, raise ``FileNotFoundError``.
     """
     model_dir = checked_model_dir(model_dir)
@@ -50,8 +50,8 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
         return _default_tracker(model_dir, detector, threads)
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
-    if model_dir is None and name in MODEL_BACKENDS:
-        model_dir = EMBEDDED_MODELS
+    if model_dir is None and name == DEFAULT_MODEL_TRACKER:
+        model_dir = EMBEDDED_MODELS  # the only model whose files ship with the package
     backend = make_backend(name, model_dir, threads)  # missing model files fail here, not on init()
     model = str(model_dir) if name in MODEL_BACKENDS else None
     return SubjectTracker(name, backend, detector, _SETTINGS.get(name), model=model)
