@@ -14,16 +14,19 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, MAX_TIMEOUT, ORIENTATIONS,
-                           FIRST_SEQ, GimbalClient, lookup, position_message, speed_message)
+from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, GimbalClient,
+                           lookup, position_message, speed_message)
 from gimbal.errors import GimbalError, GimbalTimeoutError, RangeError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
+from gimbal.matcher import FIRST_SEQ
 from gimbal.messages import Message, message_packet
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_STATES, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, JoystickPush)
-from gimbal.messages.motion import ANGLE_RANGES, AXES, GetAngles, from_raw
-from gimbal.messages.settings import (LIMIT_RANGES, ActiveTrack, GetAngleLimits, GetMotorStiffness,
+from gimbal.messages.limits import (ANGLE_RANGES, DIAL_RANGE, FOCUS_POSITION_RANGE, JOYSTICK_RANGE,
+                                    LIMIT_RANGES, MAX_SPEED_DPS, SPEED_RANGE, STIFFNESS_RANGES, TIME_RANGE)
+from gimbal.messages.motion import AXES, GetAngles, PositionControl, SpeedControl, from_raw, to_raw
+from gimbal.messages.settings import (ActiveTrack, GetAngleLimits, GetMotorStiffness,
                                       RecenterSelfie, SetAngleLimits, SetFollowMode,
                                       SetMotorStiffness, SetWorkMode, SELFIE)
 from gimbal.messages.telemetry import (PUSH_DISABLE, PUSH_ENABLE, ParameterPush, PushControl,
@@ -32,10 +35,13 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
                                         GetUserParams, SetUserParams, Tlv, autotune,
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
+from gimbal.session import MAX_TIMEOUT
+from gimbal.values import shown
 from pipelines.cli.bus import open_host_bus
-from pipelines.cli.firmware_opts import add_legacy_order_option
-from pipelines.cli.common import (CliError, add_bus_options, hold_on_devnull, parse_int, parse_seconds,
+from pipelines.cli.common import (CliError, add_bus_options, parse_int, parse_seconds,
                                   suppress_defaults)
+from pipelines.cli.firmware_opts import add_legacy_order_option
+from pipelines.cli.process import hold_on_devnull
 
 Result = dict[str, Any]
 LIMITS = tuple(LIMIT_RANGES)
@@ -61,8 +67,9 @@ class Command:
 
 # -- helpers ---------------------------------------------------------------------------------
 
-def _deg(raw: int | None) -> float | None:
-    return None if raw is None else from_raw(raw)
+def _span(limits: tuple[int, int], unit: Callable[[int], float] = float) -> str:
+    """A document range for help text, e.g. ``-180..180`` (``unit`` converts from wire units)."""
+    return f"{unit(limits[0]):g}..{unit(limits[1]):g}"
 
 
 def _angles(client: GimbalClient, kind: str) -> Result:
@@ -104,12 +111,12 @@ def describe_push(message: Message, t: float) -> Result:
     """A device push as readable values (angles in degrees)."""
     out: Result = {"t": round(t, 4), "push": message.NAME}
     if isinstance(message, ParameterPush):
-        if message.angles_valid:
-            out["attitude"] = {a: _deg(getattr(message, f"{a}_angle")) for a in AXES}
-        if message.joint_valid:
-            out["joint"] = {a: _deg(getattr(message, f"{a}_joint_angle")) for a in AXES}
+        if message.attitude is not None:
+            out["attitude"] = message.attitude._asdict()
+        if message.joint is not None:
+            out["joint"] = message.joint._asdict()
         if message.limits_valid:
-            out["limits"] = {n: getattr(message, n) for n in LIMITS}
+            out["limits"] = signed_limits({n: getattr(message, n) for n in LIMITS})
         if message.stiffness_valid:
             out["stiffness"] = {a: getattr(message, f"{a}_stiffness") for a in STIFFNESS}
     elif isinstance(message, CalibrationStatusPush):
@@ -151,18 +158,39 @@ def _angles_messages(args: argparse.Namespace) -> list[Message]:
 def _move_args(p: argparse.ArgumentParser) -> None:
     for axis, (low, high) in ANGLE_RANGES.items():
         p.add_argument(f"--{axis}", type=float,
-                       help=f"{axis} in degrees ({from_raw(low):g}..{from_raw(high):g}); omitted axes stay")
+                       help=f"{axis} in degrees ({_span((low, high), from_raw)}); omitted axes stay")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--absolute", dest="absolute", action="store_true", default=True,
                       help="angles are absolute (default)")
     mode.add_argument("--relative", dest="absolute", action="store_false", help="angles are offsets")
-    p.add_argument("--time", type=float, default=2.0, help="seconds to get there, 0..25.5 (default 2)")
+    p.add_argument("--time", type=float, default=2.0,
+                   help=f"seconds to get there, {_span(TIME_RANGE, from_raw)} (default 2)")
+
+
+def _check_field(option: str, value: float, message: type[Message], field: str, raw_range: tuple[int, int]) -> None:
+    """``CliError`` naming ``--option`` unless ``value`` (degrees, °/s or s) fits ``field`` of the
+    document's ``message``; a number too large for the wire at all (1e308) is told in the
+    document's units."""
+    step, unit = message.UNITS[field]
+    try:
+        raw = to_raw(value, option)
+    except RangeError:
+        low, high = raw_range
+        raise CliError(f"--{option} {shown(value)} is outside the document's {low * step:g}..{high * step:g}"
+                       f"{unit}") from None
+    try:
+        message(**{field: raw}).validate()
+    except RangeError as exc:
+        raise CliError(f"--{option}: {exc}") from None
 
 
 def _move_message(args: argparse.Namespace) -> list[Message]:
     axes = [a for a in AXES if getattr(args, a) is not None]
     if not axes:
         raise CliError("give at least one of --yaw, --roll, --pitch")
+    for axis in axes:
+        _check_field(axis, getattr(args, axis), PositionControl, f"{axis}_angle", ANGLE_RANGES[axis])
+    _check_field("time", args.time, PositionControl, "time_for_action", TIME_RANGE)
     return [position_message(args.yaw or 0.0, args.roll or 0.0, args.pitch or 0.0,
                              absolute=args.absolute, time_s=args.time, axes=axes)]
 
@@ -175,9 +203,16 @@ def _move(client: GimbalClient, args: argparse.Namespace) -> Result:
             "time_s": args.time}
 
 
+def _speed_messages(args: argparse.Namespace) -> list[Message]:
+    for axis in ("yaw", "pitch", "roll"):
+        _check_field(axis, getattr(args, axis), SpeedControl, f"{axis}_speed", SPEED_RANGE)
+    return [speed_message(args.yaw, args.pitch, args.roll)]
+
+
 def _speed_args(p: argparse.ArgumentParser) -> None:
     for axis in ("yaw", "pitch", "roll"):
-        p.add_argument(f"--{axis}", type=float, default=0.0, help=f"{axis} speed in °/s (-360..360)")
+        p.add_argument(f"--{axis}", type=float, default=0.0,
+                       help=f"{axis} speed in °/s ({-MAX_SPEED_DPS:g}..{MAX_SPEED_DPS:g})")
     p.add_argument("--duration", type=parse_seconds, default=1.0, help="seconds to keep turning (default 1)")
     p.add_argument("--rate", type=float, default=25.0,
                    help=f"keep-alive rate in Hz, {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} (default 25)")
@@ -196,32 +231,56 @@ def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:
     finally:
         streamer.stop()
     stats = streamer.stats
-    if stats["reply_errors"] or (stats["reply_timeouts"] and not stats["replies"]):
+    if stats["reply_errors"] or (stats["reply_timeouts"] and not (stats["replies"] or stats["late_replies"])):
         failed = " and ".join(f"{what} {stats[key]}" for what, key in (("refused", "reply_errors"),
                                                                      ("did not answer", "reply_timeouts"))
                               if stats[key])
         raise CliError(f"the gimbal {failed} of {stats['sent']} speed commands", exit_code=1)
-    return {"duration_s": args.duration, **{k: stats[k] for k in ("sent", "reply_errors", "reply_timeouts")}}
+    counts = ("sent", "reply_errors", "reply_timeouts", "late_replies")
+    return {"duration_s": args.duration, **{k: stats[k] for k in counts}}
+
+
+def _limit_degrees(name: str) -> tuple[int, int]:
+    """A limit's range in signed degrees: the document's min limits (pitch_min 0..55) say how far
+    below zero the limit lies, so the user's -55..0 (and the wire's 55..0)."""
+    high = LIMIT_RANGES[name][1]
+    return (-high, 0) if name.endswith("_min") else (0, high)
+
+
+def signed_limits(values: dict[str, int | None]) -> dict[str, int | None]:
+    """Limits as the document encodes them -> signed degrees (pitch_min 55 -> -55)."""
+    return {n: -v if n.endswith("_min") and v else v for n, v in values.items()}
+
+
+def _limits_given(args: argparse.Namespace) -> dict[str, int]:
+    """The limits given, in signed degrees, checked and encoded as the document wants them."""
+    given = {}
+    for name, value in _given(args, LIMITS).items():
+        low, high = _limit_degrees(name)
+        if not low <= value <= high:
+            raise CliError(f"--{name.replace('_', '-')} {shown(value)} is outside the document's {low}..{high}°"
+                           + (" (a limit below zero)" if low < 0 else ""))
+        given[name] = abs(value)
+    return given
 
 
 def _limits_args(p: argparse.ArgumentParser) -> None:
     for name in LIMITS:
+        low, high = _limit_degrees(name)
         p.add_argument("--" + name.replace("_", "-"), type=int, dest=name,
-                       help=f"whole degrees 0..{LIMIT_RANGES[name][1]}"
-                       + (" (below zero)" if name.endswith("min") else ""))
+                       help=f"whole degrees {low}..{high}" + (" (below zero)" if low < 0 else ""))
 
 
 def _limits_messages(args: argparse.Namespace) -> list[Message]:
+    given = _limits_given(args)
     _for_print(args, LIMITS, "limits")
-    given = _given(args, LIMITS)
     return [SetAngleLimits(1, **given)] if given else [GetAngleLimits()]
 
 
-def _read_or_update(args: argparse.Namespace, names: tuple[str, ...], field: str,
+def _read_or_update(given: dict[str, int], names: tuple[str, ...], field: str,
                     read: Callable[[], Message], write: Callable[..., None]) -> dict[str, int]:
-    """All values read; or the given ones written, the others first read back and kept.
+    """All values read; or the ``given`` ones written, the others first read back and kept.
     ``field`` turns a name into the reply's field name."""
-    given = _given(args, names)
     if given:
         current = read() if len(given) < len(names) else None
         values = {n: given.get(n, getattr(current, field.format(n), None)) for n in names}
@@ -232,13 +291,14 @@ def _read_or_update(args: argparse.Namespace, names: tuple[str, ...], field: str
 
 
 def _limits(client: GimbalClient, args: argparse.Namespace) -> Result:
-    return {"limits": _read_or_update(args, LIMITS, "{}", client.get_angle_limits,
-                                      client.set_angle_limits)}
+    return {"limits": signed_limits(_read_or_update(_limits_given(args), LIMITS, "{}", client.get_angle_limits,
+                                                    client.set_angle_limits))}
 
 
 def _stiffness_args(p: argparse.ArgumentParser) -> None:
     for axis in STIFFNESS:
-        p.add_argument(f"--{axis}", type=int, help=f"{axis} motor stiffness 0..100")
+        p.add_argument(f"--{axis}", type=int,
+                       help=f"{axis} motor stiffness {_span(STIFFNESS_RANGES[f'{axis}_stiffness'])}")
 
 
 def _stiffness_messages(args: argparse.Namespace) -> list[Message]:
@@ -250,7 +310,7 @@ def _stiffness_messages(args: argparse.Namespace) -> list[Message]:
 
 
 def _stiffness(client: GimbalClient, args: argparse.Namespace) -> Result:
-    return {"stiffness": _read_or_update(args, STIFFNESS, "{}_stiffness", client.get_stiffness,
+    return {"stiffness": _read_or_update(_given(args, STIFFNESS), STIFFNESS, "{}_stiffness", client.get_stiffness,
                                          client.set_stiffness)}
 
 
@@ -372,8 +432,8 @@ def _focus_args(p: argparse.ArgumentParser) -> None:
                    help="position: absolute position push, unanswered (sub-ID 0x01); calibrate: a "
                    "calibration step (0x02); read: calibration state and position (0x15)")
     p.add_argument("value", nargs="?",
-                   help="position 0..4095, or auto|manual|set-min|set-max|stop|none (manual: set-min "
-                   "and set-max at the two ends first, then manual)")
+                   help=f"position {_span(FOCUS_POSITION_RANGE)}, or auto|manual|set-min|set-max|stop|none "
+                   "(manual: set-min and set-max at the two ends first, then manual)")
 
 
 def _focus_messages(args: argparse.Namespace) -> list[Message]:
@@ -387,7 +447,8 @@ def _focus_messages(args: argparse.Namespace) -> list[Message]:
         try:
             return [FocusPositionControl(position=int(args.value, 0))]
         except ValueError:
-            raise CliError(f"focus position must be an integer 0..4095, not {args.value!r}") from None
+            raise CliError(f"focus position must be an integer {_span(FOCUS_POSITION_RANGE)}, "
+                           f"not {args.value!r}") from None
     return [FocusCalibration(calibration_cmd=lookup(FOCUS_CALIBRATIONS, args.value,
                                                     "focus calibration command"))]
 
@@ -409,13 +470,13 @@ def _focus(client: GimbalClient, args: argparse.Namespace) -> Result:
 
 def _joystick_args(p: argparse.ArgumentParser) -> None:
     for axis in ("yaw", "pitch", "roll"):
-        p.add_argument(f"--{axis}", type=int, default=0, help=f"{axis} stick, raw -15000..15000")
+        p.add_argument(f"--{axis}", type=int, default=0, help=f"{axis} stick, raw {_span(JOYSTICK_RANGE)}")
     p.add_argument("--duration", type=parse_seconds, default=0.5,
                    help=f"seconds to hold it (sent at {STREAM_HZ:g} Hz, then centred; default 0.5)")
 
 
 def _dial_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("speed", type=int, help="dial speed, raw -2048..2048")
+    p.add_argument("speed", type=int, help=f"dial speed, raw {_span(DIAL_RANGE)}")
     p.add_argument("--duration", type=parse_seconds, default=0.5,
                    help=f"seconds to hold it (sent at {STREAM_HZ:g} Hz, then zeroed; default 0.5)")
 
@@ -436,8 +497,8 @@ COMMANDS = [
             lambda c, a: {k: _angles(c, k) for k in _kinds(a)}, _angles_args),
     Command("move", "position control: go to (or by) angles in degrees", _move_message, _move,
             _move_args),
-    Command("speed", "turn at °/s for --duration, kept alive, then stop and release", lambda a: [
-        speed_message(a.yaw, a.pitch, a.roll)], _speed, _speed_args),
+    Command("speed", "turn at °/s for --duration, kept alive, then stop and release", _speed_messages, _speed,
+            _speed_args),
     Command("limits", "read the angle limits, or set them (unset ones are kept)", _limits_messages,
             _limits, _limits_args),
     Command("stiffness", "read motor stiffness, or set it (unset axes are kept)",
@@ -538,7 +599,7 @@ def run(command: Command, args: argparse.Namespace) -> int:
             message.validate()
         if args.print_packet:
             if not 0 <= args.seq <= 0xFFFF:
-                raise CliError(f"--seq must be 0..0xFFFF (SEQ is 2 bytes), not {args.seq:#x}")
+                raise CliError(f"--seq must be 0..0xFFFF (SEQ is 2 bytes), not {shown(args.seq)}")
             for offset, message in enumerate(messages):
                 packet = message_packet(message, (args.seq + offset) & 0xFFFF,
                                         command.cmd_types.get(type(message)))
