@@ -13,7 +13,7 @@ from pipelines.cli.common import CliError, existing_dir, existing_file
 from pipelines.progress import ProgressReporter
 from tracker.datasets import GROUNDTRUTH_NAMES, FrameReadError, Sequence, load_sequence
 from tracker.evaluation import SequenceResult, Trackable, first_box, run_sequence, summarize
-from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers, make_tracker
+from tracker.registry import DEFAULT_BACKEND, DEFAULT_MODEL_TRACKER, available_trackers, make_tracker
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -39,10 +39,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "its video (OTB x,y,w,h or VOT polygon lines, one per frame)")
     parser.add_argument("--tracker", default="default", metavar="NAME",
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
-                        f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND})")
+                        f"{DEFAULT_MODEL_TRACKER} on the model files shipped with gimbaltrack, else {DEFAULT_BACKEND})")
     parser.add_argument("--model-dir", type=existing_dir, metavar="DIR",
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
-                        "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: none)")
+                        "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: the files shipped with gimbaltrack)")
     parser.add_argument("--json", action="store_true", help="one JSON object per sequence, then a summary object")
     parser.set_defaults(func=run)
 
@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
             results.append(result)
             print(json.dumps(result.as_dict()) if args.json else _row(result), flush=True)
     if results:
-        summary = {"tracker": subject.name, **summarize(results)}
+        summary = {"tracker": subject.name, "model": subject.model, **summarize(results)}
         print(json.dumps(summary) if args.json else _row_summary(summary))
     return 0 if len(results) == len(sequences) else 2
 

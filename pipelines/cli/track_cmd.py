@@ -24,6 +24,7 @@ from pipelines.sources import FrameSource, SourceError, open_source
 from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
 from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
+from tracker.registry import DEFAULT_MODEL_TRACKER
 
 DEFAULT_DETECTOR = "motion"
 FPS_RANGE = (0.1, 1000.0)  # a frame every 10 s to 1000 a second; the video writer takes these
@@ -58,10 +59,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
-                         "is nanotrack when --model-dir holds its files, else dcf)")
+                         f"is {DEFAULT_MODEL_TRACKER} on the model files shipped with gimbaltrack, else dcf)")
     subject.add_argument("--model-dir", type=existing_dir,
-                         help="folder with optional model files: NanoTrack (then the default tracker) and "
-                         "YuNet (then the face detector)")
+                         help="folder with optional model files: NanoTrack v3 (instead of the shipped ones), "
+                         "NanoTrack v2, VitTrack, FEAR-XS and YuNet (then the face detector)")
     control = parser.add_argument_group("control")
     control.add_argument("--controller", choices=controller_names(), default="pid",
                          help="pid: world-frame Kalman + PID + feed-forward (default); p: proportional baseline")
