@@ -5,6 +5,7 @@ import math
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Protocol
 
 import numpy as np
@@ -13,6 +14,12 @@ from tracker.boxes import Box, center, from_center
 from tracker.datasets import ASSUMED_FPS, Sequence
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.metrics import has_truth, precision_at, success_auc
+from tracker.nanotrack import nanotrack_model_files
+
+#: The model files each tracker that has some reads from its model folder, so that a score names
+#: the networks behind it (a backend with model files adds its finder here).
+MODEL_FILE_FINDERS: dict[str, Callable[[Path | None], tuple[Path, ...]]] = {
+    "nanotrack": nanotrack_model_files, "nano": nanotrack_model_files}
 
 
 class Trackable(Protocol):
@@ -122,3 +129,10 @@ def summarize(results: list[SequenceResult]) -> dict[str, float | None]:
             "auc": round(float(np.mean([r.auc for r in results])), 4),
             "fps": _median_rate(r.fps for r in results),
             "cpu_fps": _median_rate(r.cpu_fps for r in results)}
+
+
+def tracker_model_files(tracker: str, model_dir: Path | None) -> tuple[Path, ...] | None:
+    """The model files ``tracker`` (a name as ``SubjectTracker.name`` gives it, not ``default``)
+    reads from ``model_dir``; None for a tracker without model files."""
+    finder = MODEL_FILE_FINDERS.get(tracker)
+    return None if finder is None else tuple(finder(model_dir))
