@@ -242,7 +242,7 @@ def connect(address: str) -> Any:
         return Client(address)
     except ValueError as exc:
         raise BatchError(f"--scheduler {address!r} is not a Dask scheduler address ({exc}; e.g. "
-                         "tcp://10.0.0.5:8786)") from None
+                         "tcp://scheduler-host:8786)") from None
     except OSError as exc:
         raise BatchError(f"no Dask scheduler answers at {address} ({exc})") from None
 

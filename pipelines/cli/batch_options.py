@@ -17,7 +17,7 @@ def add_batch_options(parser: argparse.ArgumentParser, inputs: str) -> None:
                        "are those of a run with --jobs 1")
     group.add_argument("--scheduler", metavar="ADDRESS",
                        help="run them on the Dask cluster whose scheduler is at ADDRESS (e.g. "
-                       "tcp://10.0.0.5:8786; needs pip install 'gimbaltrack[dask]', and every worker needs "
+                       "tcp://scheduler-host:8786; needs pip install 'gimbaltrack[dask]', and every worker needs "
                        "gimbaltrack and the input paths); not with --jobs")
 
 
@@ -29,7 +29,7 @@ def batch_jobs(args: argparse.Namespace) -> int:
     if args.jobs is not None and args.jobs < 1:
         raise CliError(f"--jobs takes 1 or more worker processes, not {args.jobs}")
     if args.scheduler is not None and not args.scheduler.strip():
-        raise CliError("--scheduler takes the address of a Dask scheduler, e.g. tcp://10.0.0.5:8786")
+        raise CliError("--scheduler takes the address of a Dask scheduler, e.g. tcp://scheduler-host:8786")
     return args.jobs or 1
 
 

@@ -32,7 +32,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--groundtruth ../shared/data/sequences/vot_bag/groundtruth.txt\n"
         "  gimbaltrack eval ../shared/data/sequences/otb_girl --tracker nanotrack --model-dir ../shared/data/models\n\n"
         "  gimbaltrack eval ../shared/data/sequences/* --jobs 2\n"
-        "  gimbaltrack eval ../shared/data/sequences/* --scheduler tcp://10.0.0.5:8786 --json\n\n"
+        "  gimbaltrack eval ../shared/data/sequences/* --scheduler tcp://scheduler-host:8786 --json\n\n"
         "Rows come in the order the sequences were given, whatever finishes first; --json's summary\n"
         "  names the tracker and its model files (null without).\n"
         "exit status: 0 done; 2 bad input; 130 Ctrl-C (the rows finished are printed, no summary).\n"
