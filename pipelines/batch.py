@@ -212,9 +212,9 @@ def one_thread() -> None:
 
 def _on_dask(task: Callable[[T], Any], inputs: Sequence[tuple[str, T]], address: str,
              on_done: Callable[[Outcome], None]) -> None:
-    from distributed import as_completed
-
     with connect(address) as client:
+        from distributed import as_completed  # installed: connect() says so in words otherwise
+
         futures = {client.submit(_attempt_on_dask, task, index, name, item, pure=False): (index, name)
                    for index, (name, item) in enumerate(inputs)}
         try:
