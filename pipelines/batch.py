@@ -4,6 +4,7 @@ naming it, not the end of the batch; a stop (Ctrl-C, SIGTERM) asks the workers t
 finished and goes on unwinding."""
 from __future__ import annotations
 
+import logging
 import multiprocessing
 import os
 import signal
@@ -118,7 +119,8 @@ def _in_processes(task: Callable[[T], Any], inputs: Sequence[tuple[str, T]], job
     context = multiprocessing.get_context("spawn")  # fresh interpreters: the one-thread variables apply
     stop = context.Event()
     with _one_thread_environment():
-        executor = ProcessPoolExecutor(jobs, mp_context=context, initializer=_start_worker, initargs=(stop,))
+        executor = ProcessPoolExecutor(jobs, mp_context=context, initializer=_start_worker,
+                                       initargs=(stop, logging.getLogger().getEffectiveLevel()))
         try:
             pending = {executor.submit(_attempt_in_worker, task, index, name, item): (index, name)
                        for index, (name, item) in enumerate(inputs)}
@@ -172,11 +174,13 @@ def _one_thread_environment() -> Iterator[None]:
                 os.environ[name] = value
 
 
-def _start_worker(stop: Event) -> None:
+def _start_worker(stop: Event, log_level: int) -> None:
     """A worker process: Ctrl-C in a terminal reaches every process of the group, but the parent
-    decides; it asks for a stop through ``stop``, which becomes a SIGTERM while a task runs."""
+    decides; it asks for a stop through ``stop``, which becomes a SIGTERM while a task runs. It
+    logs as the command does (``-v``, ``--debug``)."""
     global _stop_asked
     _stop_asked = stop
+    logging.basicConfig(level=log_level, format="%(levelname)s %(name)s: %(message)s")
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)  # idle: a stop has nothing to cut short
     one_thread()
