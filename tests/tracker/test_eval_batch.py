@@ -149,3 +149,10 @@ def test_a_stop_ends_the_workers_and_prints_what_finished(folders, tmp_path, sig
     assert status == code and "Traceback" not in stderr
     assert [json.loads(line)["sequence"] for line in stdout.splitlines()] == ["seq5"]  # no summary
     assert stderr.splitlines()[-1] == f"gimbaltrack eval: {last}"
+
+
+def test_two_jobs_give_the_boxes_of_one_on_real_footage(shared_data):
+    """Two shared sequences of different sizes (640 x 360 and 1280 x 720), box by box."""
+    sequences = [load_sequence(shared_data / "sequences" / name) for name in ("otb_skiing", "uav123_car14")]
+    serial, parallel = score_all(sequences, jobs=1), score_all(sequences, jobs=2)
+    assert all(o.error is None for o in serial + parallel) and scores(parallel) == scores(serial)
