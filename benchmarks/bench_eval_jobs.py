@@ -1,8 +1,10 @@
 """Wall time of ``gimbaltrack eval`` over every shared sequence, one after the other (``--jobs 1``)
 and in worker processes (``--jobs N``), alternated in one run so that both see the same load.
 
-Checks that every run prints the same rows (timings aside), then prints each run's wall time, the
-medians and their ratio. Usage:
+Checks that every run prints the same rows (timings aside), then prints each run's wall time and
+CPU time (its processes', all cores), the machine's load average beside it (other sessions share
+the 2 cores, and a saturated machine has no core to spare for a second worker), the medians and
+their ratio. Usage:
 
     .venv/bin/python benchmarks/bench_eval_jobs.py [--jobs N] [--repeats R] [SEQ ...]
 """
@@ -10,6 +12,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -22,13 +26,21 @@ from tracker.data_paths import shared_sequences
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def timed_eval(sequences: list[str], jobs: int) -> tuple[float, list[dict]]:
-    """Seconds for one ``gimbaltrack eval --json --jobs`` call, and its rows without the fps fields."""
+def timed_eval(sequences: list[str], jobs: int) -> tuple[float, float, list[dict]]:
+    """Wall and CPU seconds of one ``gimbaltrack eval --json --jobs`` call (its workers included),
+    and its rows without the fps fields."""
     command = [sys.executable, "-m", "pipelines.cli", "eval", *sequences, "--json", "--jobs", str(jobs)]
+    cpu_before = _children_cpu()
     start = time.perf_counter()
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, check=True)
     seconds = time.perf_counter() - start
-    return seconds, [{k: v for k, v in json.loads(line).items() if "fps" not in k} for line in done.stdout.splitlines()]
+    rows = [{k: v for k, v in json.loads(line).items() if "fps" not in k} for line in done.stdout.splitlines()]
+    return seconds, _children_cpu() - cpu_before, rows
+
+
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)  # waited-for descendants: the workers too
+    return usage.ru_utime + usage.ru_stime
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -46,13 +58,13 @@ def main(argv: list[str] | None = None) -> int:
     reference: list[dict] | None = None
     for _ in range(args.repeats):
         for jobs in (1, args.jobs):
-            seconds, rows = timed_eval(sequences, jobs)
+            seconds, cpu, rows = timed_eval(sequences, jobs)
             reference = reference or rows
             if rows != reference:
                 print(f"--jobs {jobs}: rows differ from the first run's", file=sys.stderr)
                 return 1
             times[jobs].append(seconds)
-            print(f"--jobs {jobs}: {seconds:6.1f} s")
+            print(f"--jobs {jobs}: {seconds:6.1f} s wall, {cpu:6.1f} s CPU, load average {os.getloadavg()[0]:.1f}")
     serial, parallel = statistics.median(times[1]), statistics.median(times[args.jobs])
     print(f"median --jobs 1 {serial:.1f} s, --jobs {args.jobs} {parallel:.1f} s: "
           f"{serial / parallel:.2f}x as fast; rows identical in every run")
