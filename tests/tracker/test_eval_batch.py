@@ -11,10 +11,10 @@ from pathlib import Path
 import cv2
 import pytest
 
-from pipelines.batch import Outcome
 from pipelines.cli.eval_cmd import score_all
 from tests import fake_onnx
 from tests.support import cli_command, signalled
+from tests.tracker.batch_helpers import scores, write_otb
 from tracker.datasets import load_sequence
 from tracker.evaluation import tracker_model_files
 from tracker.synthetic import render_sequence
@@ -24,25 +24,10 @@ def gimbaltrack(*argv: str) -> subprocess.CompletedProcess:
     return subprocess.run(cli_command(*argv), capture_output=True, text=True, timeout=180)
 
 
-def write_otb(folder: Path, frames: int, seed: int) -> Path:
-    """A rendered OTB-style sequence (its own subject path for each ``seed``)."""
-    seq = render_sequence(frames=frames, seed=seed)
-    (folder / "img").mkdir(parents=True)
-    for i, frame in enumerate(seq.frames, 1):
-        cv2.imwrite(str(folder / "img" / f"{i:04d}.png"), frame)
-    (folder / "groundtruth_rect.txt").write_text("".join(",".join(f"{v:.1f}" for v in b) + "\n" for b in seq.boxes))
-    return folder
-
-
 @pytest.fixture(scope="module")
 def folders(tmp_path_factory) -> list[Path]:
     root = tmp_path_factory.mktemp("batch")
     return [write_otb(root / f"seq{seed}", frames, seed) for seed, frames in ((3, 40), (5, 25), (7, 50))]
-
-
-def scores(outcomes: list[Outcome]) -> list[tuple]:
-    """What must not depend on how the sequences were run: every box and both scores."""
-    return [(o.name, o.result.frames, o.result.boxes, o.result.prec20, o.result.auc) for o in outcomes]
 
 
 @pytest.mark.parametrize("tracker", ["default", "kcf"])
