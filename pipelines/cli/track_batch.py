@@ -25,9 +25,11 @@ PROG = "gimbaltrack track"
 
 @dataclass(frozen=True)
 class TrackJob:
-    """One input's run: the command's options for it alone; ``capture``: keep what it prints to
-    hand back (in a worker), else print it as it comes."""
+    """One input's run: ``run`` (the single-input ``gimbaltrack track``) with the command's options
+    for this input alone; ``capture``: keep what it prints to hand back (in a worker), else print it
+    as it comes."""
 
+    run: Callable[[argparse.Namespace], int]
     args: argparse.Namespace
     capture: bool
 
@@ -42,15 +44,16 @@ class TrackResult:
     error: str | None = None
 
 
-def run_track_batch(args: argparse.Namespace) -> int:
-    """Run every ``args.source``; the exit status of the worst run (0 when all went well)."""
+def run_track_batch(args: argparse.Namespace, run: Callable[[argparse.Namespace], int]) -> int:
+    """Run every ``args.source`` with ``run``, which takes one (a module-level function: workers load
+    it by name); the exit status of the worst run (0 when all went well)."""
     jobs = batch_jobs(args)
     if args.interface != SIM_INTERFACE:
         raise CliError(f"{len(args.source)} inputs need the simulated gimbal, each its own (one gimbal cannot "
                        "follow two subjects): give one SOURCE with -i/--interface")
     folders = output_folders(args.source, args.out)
     here = args.scheduler is None and min(jobs, len(args.source)) == 1
-    inputs = [(source, TrackJob(_one_input(args, source, folder, quiet=args.quiet or not here), not here))
+    inputs = [(source, TrackJob(run, _one_input(args, source, folder, quiet=args.quiet or not here), not here))
               for source, folder in zip(args.source, folders)]
     statuses: list[int] = []
 
@@ -103,12 +106,10 @@ def _one_input(args: argparse.Namespace, source: str, folder: Path, quiet: bool)
 def track_one(job: TrackJob) -> TrackResult:
     """One input's ``gimbaltrack track`` run. Here (not captured) a stop ends the batch too: the
     run has finished its outputs and reported, and the stop goes on unwinding."""
-    from pipelines.cli.track_cmd import run_track  # it dispatches here: imported when first needed
-
     source = job.args.source[0]
     if not job.capture:
         try:
-            status = run_track(job.args)
+            status = job.run(job.args)
         except CliError as exc:
             return TrackResult(exc.exit_code, error=f"{source}: {exc}")
         if status == EXIT_INTERRUPTED:
@@ -119,7 +120,7 @@ def track_one(job: TrackJob) -> TrackResult:
     stdout, stderr = io.StringIO(), io.StringIO()
     with redirect_stdout(stdout), redirect_stderr(stderr):
         try:
-            status, error = run_track(job.args), None
+            status, error = job.run(job.args), None
         except CliError as exc:
             status, error = exc.exit_code, f"{source}: {exc}"
     return TrackResult(status, stdout.getvalue(), stderr.getvalue(), error)

@@ -146,7 +146,7 @@ def run_track(args: argparse.Namespace) -> int:
     options = _options(args)  # checked once for all the inputs
     batch_jobs(args)  # --jobs and --scheduler too, though one input runs here
     if len(args.source) > 1:
-        return run_track_batch(args)
+        return run_track_batch(args, run_track)
     [args.source] = args.source
     return _open_and_run(options, args)
 
