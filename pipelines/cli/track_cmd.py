@@ -14,9 +14,11 @@ from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit, deferred_signals
 from gimbal.values import shown
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
+from pipelines.cli.batch_options import add_batch_options, batch_jobs
 from pipelines.cli.bus import choose_track_bus, open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
+from pipelines.cli.track_batch import run_track_batch
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter
@@ -42,13 +44,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
         "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
         "  gimbaltrack track udp://127.0.0.1:5000 --detect person\n"
-        "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n\n"
-        "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png\n"
+        "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n"
+        "  gimbaltrack track a.mp4 b.mp4 c.mp4 --jobs 2 --out out/batch   (out/batch/a/, out/batch/b/, ...)\n\n"
+        "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png; with several\n"
+        "  SOURCEs, each in --out/<its name>/, each run against its own simulated gimbal (not on a real bus),\n"
+        "  their reports in the order given; the exit status is the worst of theirs\n"
         "exit status: 0 done; 1 the gimbal, bus, source or an output failed mid-run; 2 bad input;\n"
         "  130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to stop in every case)",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("source", help="video file, image folder, camera index (e.g. 0) or stream URL "
-                        "(udp://, rtsp://, http://)")
+    parser.add_argument("source", nargs="+", metavar="SOURCE", help="video file, image folder, camera index "
+                        "(e.g. 0) or stream URL (udp://, rtsp://, http://); several: see below")
     subject = parser.add_argument_group("subject (default: --detect motion, the largest moving thing)")
     start = subject.add_mutually_exclusive_group()
     start.add_argument("--roi", help="x,y,w,h of the subject in the first frame, in pixels (over an edge: "
@@ -104,6 +109,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_bus_options(parser, fallback="the built-in simulated gimbal")
     add_legacy_order_option(parser)
+    add_batch_options(parser, "inputs")
     parser.set_defaults(func=run_track)
 
 
@@ -142,7 +148,12 @@ def _options(args: argparse.Namespace) -> TrackOptions:
 def run_track(args: argparse.Namespace) -> int:
     # main() turns SIGTERM, SIGHUP and SIGQUIT into SignalExit: every ``with`` below stops the
     # gimbal on the way out, and _run finalises the outputs first
-    return _open_and_run(_options(args), args)
+    options = _options(args)  # checked once for all the inputs
+    batch_jobs(args)  # --jobs and --scheduler too, though one input runs here
+    if len(args.source) > 1:
+        return run_track_batch(args, run_track)
+    [args.source] = args.source
+    return _open_and_run(options, args)
 
 
 def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
