@@ -16,11 +16,13 @@ from gimbal.watchdog import DEFAULT_TIMEOUT_S, DEGRADED_SILENCE_S
 from gimbal.signals import SignalExit, deferred_signals
 from gimbal.values import shown
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
+from pipelines.cli.batch_options import add_batch_options, batch_jobs
 from pipelines.cli.bus import SIM_INTERFACE, choose_track_bus, open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.sim_faults import parse_sim_faults
 from pipelines.loop.link import link_degraded, link_report
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
+from pipelines.cli.track_batch import run_track_batch
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter
@@ -28,6 +30,7 @@ from pipelines.sources import FrameSource, SourceError, open_source
 from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
 from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
+from tracker.registry import DEFAULT_MODEL_TRACKER
 
 DEFAULT_DETECTOR = "motion"
 LISTEN_S = 0.5  # before taking control: another controller streams at 4 Hz at the least (two commands a 0.5 s)
@@ -48,16 +51,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
         "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
         "  gimbaltrack track udp://127.0.0.1:5000 --detect person\n"
-        "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n\n"
-        "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png\n"
+        "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n"
+        "  gimbaltrack track a.mp4 b.mp4 c.mp4 --jobs 2 --out out/batch   (out/batch/a/, out/batch/b/, ...)\n\n"
+        "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png; with several\n"
+        "  SOURCEs, each in --out/<its name>/, each run against its own simulated gimbal (not on a real bus),\n"
+        "  their reports in the order given; the exit status is the worst of theirs\n"
         "exit status: 0 done; 3 done, but the gimbal link was degraded (replies missing, the gimbal\n"
         "  released for silence) or another controller was seen; 4 another controller drives the gimbal\n"
         "  (nothing taken over; --shared-bus to run anyway); 1 the bus, source or an output failed\n"
         "  mid-run; 2 bad input; 130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to\n"
         "  stop in every case)",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("source", help="video file, image folder, camera index (e.g. 0) or stream URL "
-                        "(udp://, rtsp://, http://)")
+    parser.add_argument("source", nargs="+", metavar="SOURCE", help="video file, image folder, camera index "
+                        "(e.g. 0) or stream URL (udp://, rtsp://, http://); several: see below")
     subject = parser.add_argument_group("subject (default: --detect motion, the largest moving thing)")
     start = subject.add_mutually_exclusive_group()
     start.add_argument("--roi", help="x,y,w,h of the subject in the first frame, in pixels (over an edge: "
@@ -68,10 +74,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
-                         "is nanotrack when --model-dir holds its files, else dcf)")
+                         f"is {DEFAULT_MODEL_TRACKER} on the model files shipped with gimbaltrack, else dcf)")
     subject.add_argument("--model-dir", type=existing_dir,
-                         help="folder with optional model files: NanoTrack (then the default tracker) and "
-                         "YuNet (then the face detector)")
+                         help="folder with optional model files: NanoTrack v3 (instead of the shipped ones), "
+                         "NanoTrack v2, VitTrack, FEAR-XS and YuNet (then the face detector)")
     control = parser.add_argument_group("control")
     control.add_argument("--controller", choices=controller_names(), default="pid",
                          help="pid: world-frame Kalman + PID + feed-forward (default); p: proportional baseline")
@@ -125,6 +131,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                       "drop, corrupt, fault-direction, delay-ms, nack, silent (START:END s), seed; "
                       "e.g. drop=0.2 or silent=6:6.3")
     add_legacy_order_option(parser)
+    add_batch_options(parser, "inputs")
     parser.set_defaults(func=run_track)
 
 
@@ -167,7 +174,12 @@ def _options(args: argparse.Namespace) -> TrackOptions:
 def run_track(args: argparse.Namespace) -> int:
     # main() turns SIGTERM, SIGHUP and SIGQUIT into SignalExit: every ``with`` below stops the
     # gimbal on the way out, and _run finalises the outputs first
-    return _open_and_run(_options(args), args)
+    options = _options(args)  # checked once for all the inputs
+    batch_jobs(args)  # --jobs and --scheduler too, though one input runs here
+    if len(args.source) > 1:
+        return run_track_batch(args, run_track)
+    [args.source] = args.source
+    return _open_and_run(options, args)
 
 
 def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
