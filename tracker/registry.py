@@ -11,8 +11,10 @@ from tracker.subject import SubjectTracker, TrackerSettings
 
 DEFAULT_BACKEND = "dcf"  # best measured without model files (docs/tracker.md)
 DEFAULT_WITH_MODELS = "nanotrack"  # best measured when the NanoTrack files are given
-# The template refinement corrects CSRT's drift; the correlation filter's own peak is finer.
-_SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0)}
+# The template refinement corrects CSRT's drift; the correlation filter's own peak is finer. The
+# template search may restart dcf only once the subject is lost: dcf keeps following through a few
+# unsure frames, and restarting it there put it on look-alike background (docs/tracker.md).
+_SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1)}
 
 
 def available_trackers() -> list[str]:

@@ -160,6 +160,17 @@ def test_backend_keeps_the_size_of_a_subject_doubling_in_size():
     assert max(abs(math.log(r)) for r in ratios) < math.log(1.09)
 
 
+def test_backend_follows_a_slow_shrink_within_its_finer_scale_ladder():
+    """A subject shrinking to 0.6 over 120 frames (under a third of a per cent a frame, as drone
+    footage's subjects do): with 33 scale samples 1.02 apart the size stays within 4.5 % of the
+    truth; the coarser 17 at 1.03 lagged by up to 5.5 %."""
+    seq = render_sequence(frames=120, target=48, speed=1.0, scale_change=0.6, seed=2)
+    backend = DcfBackend()
+    backend.init(seq.frames[0], seq.boxes[0])
+    ratios = [backend.update(frame)[0][2] / truth[2] for frame, truth in zip(seq.frames[1:], seq.boxes[1:])]
+    assert max(abs(math.log(r)) for r in ratios) < math.log(1.045)
+
+
 def test_backend_scores_drop_behind_an_occluder():
     seq = render_sequence(frames=60, occlusion=(25, 45), seed=1)
     backend = DcfBackend()
