@@ -12,6 +12,7 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import socket
 import threading
 from collections.abc import Awaitable, Callable
 from importlib import resources
@@ -36,6 +37,8 @@ DEFAULT_WIDTH = 960
 FPS_RANGE = (0.5, 60.0)
 WIDTH_RANGE = (64, 3840)
 EVENTS_PERIOD_S = 0.2
+SEND_BUFFER_BYTES = 64 * 1024
+FLUSH_POLL_S = 0.005
 STALL_S = 10.0  # a viewer that has not taken a frame in this long is dropped (its slot freed)
 BOUNDARY = "frame"
 STATIC = resources.files("pipelines.console") / "static"
@@ -82,6 +85,7 @@ class ConsoleServer:
         self._start_error: BaseException | None = None
         self._closing: asyncio.Event | None = None
         self._new_frame: asyncio.Event | None = None
+        self._main_task: asyncio.Task | None = None
 
     # -- lifetime ---------------------------------------------------------------------------
     @property
@@ -109,7 +113,8 @@ class ConsoleServer:
     def _serve(self) -> None:
         loop = self._loop = asyncio.new_event_loop()
         try:
-            loop.run_until_complete(self._main())
+            self._main_task = loop.create_task(self._main())
+            loop.run_until_complete(self._main_task)
         except BaseException as exc:  # a dying server must stop the run (and the gimbal)
             if not self._ready.is_set():
                 self._start_error = exc
@@ -123,10 +128,10 @@ class ConsoleServer:
     async def _main(self) -> None:
         self._closing = asyncio.Event()
         self._new_frame = asyncio.Event()
-        runner = web.AppRunner(self.app(), access_log=None, handle_signals=False)
+        runner = web.AppRunner(self.app(), access_log=None, handle_signals=False, shutdown_timeout=1.0)
         await runner.setup()
         try:
-            site = web.TCPSite(runner, self.address.host, self.address.port, shutdown_timeout=1.0)
+            site = web.TCPSite(runner, self.address.host, self.address.port)
             await site.start()
             self.port = runner.addresses[0][1]
             self._ready.set()
@@ -213,15 +218,17 @@ class ConsoleServer:
             response = web.StreamResponse(headers={
                 "Content-Type": f"multipart/x-mixed-replace; boundary={BOUNDARY}",
                 "Cache-Control": "no-store"})
+            _small_send_buffer(request)
             await response.prepare(request)
-            await self._send_frames(response, 1.0 / fps, width)
+            await self._send_frames(request, response, 1.0 / fps, width)
             return response
         except (ConnectionError, asyncio.TimeoutError):
             return web.Response(status=499)
         finally:
             self.viewers -= 1
 
-    async def _send_frames(self, response: web.StreamResponse, period: float, width: int) -> None:
+    async def _send_frames(self, request: web.Request, response: web.StreamResponse, period: float,
+                           width: int) -> None:
         """Newest frame, at most once a ``period``; frames that come while a slow viewer is still
         reading the last one are skipped for it (a write that stalls ``STALL_S`` ends the view)."""
         loop = asyncio.get_running_loop()
@@ -237,6 +244,7 @@ class ConsoleServer:
                     f"X-Frame-Index: {snapshot.record.frame_index}\r\n"
                     f"X-Capture-Time: {snapshot.record.capture_t:.6f}\r\n\r\n").encode()
             await asyncio.wait_for(response.write(head + jpeg + b"\r\n"), STALL_S)
+            await asyncio.wait_for(_flushed(request), STALL_S)
             await self._sleep_or_close(due - loop.time())
 
     async def _next_frame(self, after_seq: int) -> Snapshot | None:
@@ -299,6 +307,23 @@ class ConsoleServer:
 
     def _settings(self, raw: bytes) -> None:
         self.operator.apply_settings(parse_settings(raw))
+
+
+def _small_send_buffer(request: web.Request) -> None:
+    """A send buffer of about one frame, so a slow viewer's backlog is short: it is shown a frame
+    a little old, then the newest, never a queue of stale ones."""
+    sock = request.transport.get_extra_info("socket") if request.transport is not None else None
+    if sock is not None:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER_BYTES)
+
+
+async def _flushed(request: web.Request) -> None:
+    """Until the last part has left this process for the kernel's send buffer."""
+    transport = request.transport
+    while transport is not None and not transport.is_closing() and transport.get_write_buffer_size():
+        await asyncio.sleep(FLUSH_POLL_S)
+    if transport is None or transport.is_closing():
+        raise ConnectionResetError("the viewer went away")
 
 
 def _dumps(value: Any) -> str:

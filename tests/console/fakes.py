@@ -51,10 +51,14 @@ class FakeOperator:
                 "settings": {"max_speed": 120.0}}
 
 
-def synthetic_image(index: int) -> np.ndarray:
-    """A frame that changes every time: a bright bar moving across a gradient."""
+def synthetic_image(index: int, noisy: bool = False) -> np.ndarray:
+    """A frame that changes every time: a bright bar moving across a gradient; ``noisy``: over
+    noise instead, which JPEG cannot shrink much (parts of a camera frame's size, ~100 kB)."""
     width, height = SIZE
-    image = np.tile(np.linspace(0, 120, width, dtype=np.uint8)[None, :, None], (height, 1, 3))
+    if noisy:
+        image = np.random.default_rng(index).integers(0, 120, (height, width, 3), dtype=np.uint8)
+    else:
+        image = np.tile(np.linspace(0, 120, width, dtype=np.uint8)[None, :, None], (height, 1, 3))
     x = (index * 8) % (width - 20)
     image[:, x:x + 20] = 255
     return image
@@ -64,12 +68,13 @@ class FrameFeeder:
     """Calls ``sink.on_frame`` at up to ``fps`` from its own thread (the loop's stand-in);
     ``fps=None`` as fast as it can. ``rate()`` is the frames per second it achieved."""
 
-    def __init__(self, sink: ConsoleSink, fps: float | None = 30.0, work_s: float = 0.0) -> None:
+    def __init__(self, sink: ConsoleSink, fps: float | None = 30.0, work_s: float = 0.0,
+                 noisy: bool = False) -> None:
         self.sink, self.fps, self.work_s = sink, fps, work_s
         self.frames = 0
         self.error: BaseException | None = None
         self._stop = threading.Event()
-        self._images = [synthetic_image(i) for i in range(16)]
+        self._images = [synthetic_image(i, noisy) for i in range(16)]
         self._thread = threading.Thread(target=self._run, daemon=True)
         self.started = self.ended = 0.0
 

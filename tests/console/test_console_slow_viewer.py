@@ -1,0 +1,49 @@
+"""A viewer that reads slowly, or not at all, never slows the loop: its frames are dropped."""
+from __future__ import annotations
+
+import time
+
+from tests.console.fakes import FrameFeeder, start_console
+from tests.console.http_helpers import MjpegReader, stalled_viewer
+from tests.support import wait_until
+
+RATE = 100.0  # the loop's frame rate, frames handed to the sink per second
+SECONDS = 2.0
+
+
+def _loop_rate(sink, during=None) -> float:
+    with FrameFeeder(sink, fps=RATE, work_s=0.002, noisy=True) as feeder:
+        if during is not None:
+            during(feeder)
+        time.sleep(SECONDS)
+    return feeder.rate()
+
+
+def test_a_stalled_and_a_slow_viewer_leave_the_loop_rate_alone() -> None:
+    server, sink, _ = start_console()
+    try:
+        baseline = _loop_rate(sink)
+        stalled = stalled_viewer(server.port)
+        slow = MjpegReader(server.port, "?fps=60&width=640", receive_buffer=16384)
+        seen: list[tuple[int, int]] = []
+
+        def read_slowly(feeder: FrameFeeder) -> None:
+            assert wait_until(lambda: server.viewers == 2, 5)
+            for _ in range(4):  # one frame every 0.4 s, at 60 fps asked
+                headers, _ = slow.part()
+                seen.append((int(headers["x-frame-index"]), feeder.frames))
+                time.sleep(0.4)
+
+        with_viewers = _loop_rate(sink, read_slowly)
+        assert with_viewers >= 0.9 * baseline, (with_viewers, baseline)
+        assert server.viewers == 2  # the stalled one is still connected, just not fed
+        # the slow reader gets recent frames, not a backlog: frames are skipped for it, and each one
+        # it is shown is at most about a second behind the loop (what the socket buffers hold)
+        shown = [s for s, _ in seen[1:]]
+        assert all(b - a > 5 for a, b in zip(shown, shown[1:])), seen
+        assert all(handed - s <= RATE for s, handed in seen[1:]), seen
+        stalled.close()
+        slow.close()
+    finally:
+        server.stop()
+        sink.close()
