@@ -3,7 +3,6 @@ virtual bus (and the built-in simulator when it is present)."""
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import random
 import signal
@@ -299,7 +298,6 @@ def test_the_python_example_in_the_docs_runs(channel: str, peer: ScriptedPeer,
     assert "Angles(kind='attitude', yaw=1.0, roll=2.0, pitch=3.0)" in capsys.readouterr().out
 
 
-@pytest.mark.skipif(importlib.util.find_spec("gimbal.sim") is None, reason="gimbal.sim not built yet")
 def test_the_simulated_gimbal_answers(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["gimbal", "version", "-i", "sim", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["device_id"] == 1

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 from pathlib import Path
 from typing import Any
@@ -18,6 +17,7 @@ from pipelines.cli.app import build_parser
 from pipelines.control import ControlConfig
 from pipelines.outputs.telemetry import read_telemetry
 from pipelines.track_session import signed_attitude
+from tests.support import require_ffmpeg
 from tests.track.helpers import (DEMO, DEMO_ROI, SIZE, assert_stopped_at_end, decoded,
                                  host_commands, in_speed_range, make_clip, roi_at, run_track,
                                  speed_commands)
@@ -189,11 +189,11 @@ def test_a_subject_never_acquired_is_said_and_recording_never_started(
     assert not [r for r in host_commands(decoded(tmp_path / "out" / "can.log")) if r["name"] == "camera_action"]
 
 
-@pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs ffmpeg to cut a clip short")
 def test_a_file_cut_short_ends_with_a_warning(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Its index in front (faststart), the frames cut off: it decodes to the cut, then stops."""
+    ffmpeg = require_ffmpeg("a clip cut short")
     whole = tmp_path / "whole.mp4"
-    subprocess.run(["ffmpeg", "-loglevel", "error", "-i", str(DEMO), "-c", "copy", "-movflags", "faststart",
+    subprocess.run([ffmpeg, "-loglevel", "error", "-i", str(DEMO), "-c", "copy", "-movflags", "faststart",
                     str(whole)], check=True)
     cut = tmp_path / "cut.mp4"
     cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])
