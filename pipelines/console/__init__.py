@@ -6,9 +6,15 @@ serves it with aiohttp on a thread of its own and hands the operator's requests 
 ``ConsoleOperator`` (the loop side), which runs them on the loop's thread.
 """
 from pipelines.console.address import ConsoleAddress, parse_console_address
-from pipelines.console.operator import ConsoleOperator, ConsoleRecord
+from pipelines.console.operator import ConsoleOperator, ConsoleView
 from pipelines.console.server import ConsoleServer
 from pipelines.console.sink import ConsoleSink
 
-__all__ = ["ConsoleAddress", "ConsoleOperator", "ConsoleRecord", "ConsoleServer", "ConsoleSink",
-           "parse_console_address"]
+__all__ = [
+           "ConsoleAddress",
+           "ConsoleOperator",
+           "ConsoleServer",
+           "ConsoleSink",
+           "ConsoleView",
+           "parse_console_address",
+]

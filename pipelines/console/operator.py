@@ -5,7 +5,8 @@ so a request never races the tracker or the keep-alive. What came of it shows in
 """
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 #: Live settings the console may change, with their ranges (the controller checks them again).
@@ -20,8 +21,10 @@ SETTING_RANGES: Mapping[str, tuple[float, float]] = {
 }
 
 
-class ConsoleRecord(Protocol):
-    """One processed frame as the console draws it (pixels of the source frame)."""
+@dataclass(frozen=True)
+class ConsoleView:
+    """One processed frame as the console shows it (boxes in pixels of the source frame); the
+    sink's ``describe`` makes it from the loop's own record."""
 
     frame_index: int
     capture_t: float  # time.monotonic() of the capture
@@ -29,7 +32,7 @@ class ConsoleRecord(Protocol):
     box: tuple[float, float, float, float] | None
     confidence: float | None
     rates_dps: tuple[float, float]
-    candidates: Sequence[tuple[float, float, float, float]]  # detector boxes while acquiring
+    candidates: tuple[tuple[float, float, float, float], ...] = ()  # the detector's boxes, when it ran
 
 
 class ConsoleOperator(Protocol):

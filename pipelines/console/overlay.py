@@ -6,7 +6,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from pipelines.console.operator import ConsoleRecord
+from pipelines.console.operator import ConsoleView
 
 STATE_COLOURS = {  # BGR, as the annotated video's
     "tracking": (0, 200, 0),
@@ -35,21 +35,21 @@ def _box(image: np.ndarray, box: tuple[float, ...], scale: float, colour: tuple[
     cv2.rectangle(image, (x, y), (x + w, y + h), colour, thickness)
 
 
-def draw(image: np.ndarray, record: ConsoleRecord, scale: float, dead_zone_px: float) -> None:
-    """Draw ``record`` on ``image`` (shrunk by ``scale`` from the source frame) in place."""
+def draw(image: np.ndarray, view: ConsoleView, scale: float, dead_zone_px: float) -> None:
+    """Draw ``view`` on ``image`` (shrunk by ``scale`` from the source frame) in place."""
     height, width = image.shape[:2]
     centre = (width // 2, height // 2)
     cv2.drawMarker(image, centre, CENTRE_COLOUR, cv2.MARKER_CROSS, 20, 1)
     zone = max(2, round(dead_zone_px * scale))
     cv2.rectangle(image, (centre[0] - zone, centre[1] - zone), (centre[0] + zone, centre[1] + zone),
                   CENTRE_COLOUR, 1)
-    for candidate in record.candidates:
+    for candidate in view.candidates:
         _box(image, candidate, scale, CANDIDATE_COLOUR, 1)
-    if record.box is not None:
-        _box(image, record.box, scale, STATE_COLOURS.get(record.state, CENTRE_COLOUR), 2)
-    confidence = "" if record.confidence is None else f" conf {record.confidence:.2f}"
-    text = (f"#{record.frame_index} {record.state}{confidence} "
-            f"yaw {record.rates_dps[0]:+.1f} pitch {record.rates_dps[1]:+.1f} deg/s")
+    if view.box is not None:
+        _box(image, view.box, scale, STATE_COLOURS.get(view.state, CENTRE_COLOUR), 2)
+    confidence = "" if view.confidence is None else f" conf {view.confidence:.2f}"
+    text = (f"#{view.frame_index} {view.state}{confidence} "
+            f"yaw {view.rates_dps[0]:+.1f} pitch {view.rates_dps[1]:+.1f} deg/s")
     (w, h), base = cv2.getTextSize(text, _FONT, 0.5, 1)
     cv2.rectangle(image, (4, 4), (12 + w, 10 + h + base), (0, 0, 0), cv2.FILLED)
     cv2.putText(image, text, (8, 8 + h), _FONT, 0.5, (255, 255, 255), 1, cv2.LINE_8)

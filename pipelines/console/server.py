@@ -21,8 +21,14 @@ from typing import Any
 from aiohttp import web
 
 from pipelines.console.address import ConsoleAddress
-from pipelines.console.bodies import (MAX_BODY_BYTES, RequestError, parse_empty, parse_record,
-                                      parse_select, parse_settings)
+from pipelines.console.bodies import (
+    MAX_BODY_BYTES,
+    RequestError,
+    parse_empty,
+    parse_record,
+    parse_select,
+    parse_settings,
+)
 from pipelines.console.operator import ConsoleOperator
 from pipelines.console.security import Guard
 from pipelines.console.sink import ConsoleSink, Snapshot
@@ -173,11 +179,11 @@ class ConsoleServer:
 
     # -- status -----------------------------------------------------------------------------
     def state(self) -> dict[str, Any]:
-        """The newest frame's record and the operator's status, JSON-ready."""
+        """The newest frame's view and the operator's status, JSON-ready."""
         snapshot = self.sink.latest()
         frame: dict[str, Any] = {"frame": None}
         if snapshot is not None:
-            r = snapshot.record
+            r = snapshot.view
             frame = {"frame": r.frame_index, "capture_t": r.capture_t, "state": r.state, "box": r.box,
                      "confidence": r.confidence, "rates_dps": r.rates_dps, "candidates": r.candidates}
         return to_plain({**frame, "frame_size": self.operator.frame_size(), **self.operator.state(),
@@ -199,7 +205,7 @@ class ConsoleServer:
                 await asyncio.wait_for(response.write(data), STALL_S)
                 await self._sleep_or_close(EVENTS_PERIOD_S)
             return response
-        except (ConnectionError, asyncio.TimeoutError):
+        except (TimeoutError, ConnectionError):
             return web.Response(status=499)  # the viewer went away; nothing more to send
         finally:
             self.event_streams -= 1
@@ -222,7 +228,7 @@ class ConsoleServer:
             await response.prepare(request)
             await self._send_frames(request, response, 1.0 / fps, width)
             return response
-        except (ConnectionError, asyncio.TimeoutError):
+        except (TimeoutError, ConnectionError):
             return web.Response(status=499)
         finally:
             self.viewers -= 1
@@ -241,8 +247,8 @@ class ConsoleServer:
             seq = snapshot.seq
             jpeg = await loop.run_in_executor(self.sink.executor, self.sink.encode, snapshot, width)
             head = (f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(jpeg)}\r\n"
-                    f"X-Frame-Index: {snapshot.record.frame_index}\r\n"
-                    f"X-Capture-Time: {snapshot.record.capture_t:.6f}\r\n\r\n").encode()
+                    f"X-Frame-Index: {snapshot.view.frame_index}\r\n"
+                    f"X-Capture-Time: {snapshot.view.capture_t:.6f}\r\n\r\n").encode()
             await asyncio.wait_for(response.write(head + jpeg + b"\r\n"), STALL_S)
             await asyncio.wait_for(_flushed(request), STALL_S)
             await self._sleep_or_close(due - loop.time())
@@ -270,7 +276,7 @@ class ConsoleServer:
         if seconds > 0:
             try:
                 await asyncio.wait_for(self._closing.wait(), seconds)
-            except asyncio.TimeoutError:
+            except TimeoutError:
                 pass
 
     # -- control ----------------------------------------------------------------------------

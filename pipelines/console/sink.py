@@ -11,7 +11,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from pipelines.console.operator import ConsoleRecord
+from pipelines.console.operator import ConsoleView
 from pipelines.console.overlay import draw, shrunk
 
 JPEG_QUALITY = 80
@@ -25,16 +25,19 @@ class ConsoleFailed(OSError):
 @dataclass(frozen=True)
 class Snapshot:
     seq: int  # 1 for the first frame handed over, then one more per frame
-    record: ConsoleRecord
+    view: ConsoleView
     image: np.ndarray  # the loop's frame, never drawn on
 
 
 class ConsoleSink:
     """``on_frame(record, frame)`` from the loop's thread; ``latest()``, ``encode()`` and
-    ``wake_on_next`` from the server's. ``dead_zone_px`` gives the dead zone's half-width in
-    source pixels as it stands (settings change it)."""
+    ``wake_on_next`` from the server's. ``describe`` turns the loop's record into a
+    ``ConsoleView`` (a few attribute reads: it runs on the loop's thread); ``dead_zone_px`` gives
+    the dead zone's half-width in source pixels as it stands (settings change it)."""
 
-    def __init__(self, dead_zone_px: Callable[[], float] = lambda: 0.0, quality: int = JPEG_QUALITY) -> None:
+    def __init__(self, describe: Callable[[Any], ConsoleView] = lambda view: view,
+                 dead_zone_px: Callable[[], float] = lambda: 0.0, quality: int = JPEG_QUALITY) -> None:
+        self._describe = describe
         self._dead_zone_px = dead_zone_px
         self._quality = quality
         self._lock = threading.Lock()
@@ -45,16 +48,17 @@ class ConsoleSink:
         self.failure: BaseException | None = None
 
     # -- the loop's side --------------------------------------------------------------------
-    def on_frame(self, record: ConsoleRecord, frame: Any) -> None:
+    def on_frame(self, record: Any, frame: Any) -> None:
         """Keep ``frame`` (a ``Frame`` or an image; not copied: the loop never draws on its frames)
         as the newest; wake a viewer waiting for it. Raises ``ConsoleFailed`` once the server
         has died, so the run stops the gimbal."""
         if self.failure is not None:
             raise ConsoleFailed(f"the console stopped: {self.failure}") from self.failure
         image = getattr(frame, "image", frame)
+        view = self._describe(record)
         with self._lock:
             seq = 1 if self._latest is None else self._latest.seq + 1
-            self._latest = Snapshot(seq, record, image)
+            self._latest = Snapshot(seq, view, image)
             wake, self._wake = self._wake, None
         if wake is not None:
             wake()
@@ -91,7 +95,7 @@ class ConsoleSink:
         if cached is not None:
             return cached
         image, scale = shrunk(snapshot.image, width)
-        draw(image, snapshot.record, scale, self._dead_zone_px())
+        draw(image, snapshot.view, scale, self._dead_zone_px())
         ok, data = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, self._quality])
         if not ok:
             raise ValueError("JPEG encoding failed")

@@ -6,24 +6,23 @@ import threading
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
-from pipelines.console import ConsoleServer, ConsoleSink, parse_console_address
+from pipelines.console import (
+    ConsoleServer,
+    ConsoleSink,
+    ConsoleView,
+    parse_console_address,
+)
 
 SIZE = (640, 360)
 
 
-@dataclass(frozen=True)
-class Record:
-    frame_index: int
-    capture_t: float
-    state: str = "tracking"
-    box: tuple[float, float, float, float] | None = (100.0, 80.0, 40.0, 60.0)
-    confidence: float | None = 0.9
-    rates_dps: tuple[float, float] = (1.5, -0.5)
-    candidates: tuple = ((300.0, 100.0, 50.0, 50.0),)
+def view(index: int, t: float) -> ConsoleView:
+    return ConsoleView(index, t, "tracking", (100.0, 80.0, 40.0, 60.0), 0.9, (1.5, -0.5),
+                       ((300.0, 100.0, 50.0, 50.0),))
 
 
 @dataclass
@@ -78,7 +77,7 @@ class FrameFeeder:
         self._thread = threading.Thread(target=self._run, daemon=True)
         self.started = self.ended = 0.0
 
-    def __enter__(self) -> FrameFeeder:
+    def __enter__(self) -> Self:
         self.started = time.monotonic()
         self._thread.start()
         return self
@@ -96,7 +95,7 @@ class FrameFeeder:
                     while time.perf_counter() < end:
                         pass
                 index = self.frames
-                self.sink.on_frame(Record(index, time.monotonic()), self._images[index % len(self._images)])
+                self.sink.on_frame(view(index, time.monotonic()), self._images[index % len(self._images)])
                 self.frames += 1
                 self.ended = time.monotonic()
                 if self.fps:

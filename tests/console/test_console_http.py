@@ -2,6 +2,7 @@
 each bad input, and the limits on viewers."""
 from __future__ import annotations
 
+import itertools
 import json
 import time
 from collections.abc import Iterator
@@ -72,7 +73,7 @@ def test_the_view_is_the_newest_frame_at_the_asked_width_and_rate(console) -> No
     assert elapsed >= 0.8  # five gaps at 5 fps
     images = [decode_jpeg(data) for _, data in parts]
     assert images[0].shape == (180, 320, 3)
-    assert any(abs(a.astype(int) - b.astype(int)).mean() > 1 for a, b in zip(images, images[1:]))
+    assert any(abs(a.astype(int) - b.astype(int)).mean() > 1 for a, b in itertools.pairwise(images))
     default = MjpegReader(server.port)
     assert decode_jpeg(default.part()[1]).shape[1] == SIZE[0]  # 960 by default: a 640 frame is not grown
     default.close()

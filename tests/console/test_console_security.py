@@ -44,7 +44,7 @@ def test_loopback_needs_no_token_but_refuses_another_host_name() -> None:
         assert request(server.port, "GET", "/api/state")[0] == 200
         status, _, body = request(server.port, "GET", "/api/state", headers={"Host": f"evil.example:{server.port}"})
         assert status == 403 and "loopback only" in json.loads(body)["error"]
-        status, reply = post(server.port, "/api/pause", {}, headers={"Host": "evil.example",
+        status, _reply = post(server.port, "/api/pause", {}, headers={"Host": "evil.example",
                                                                     "Origin": "http://evil.example"})
         assert status == 403 and operator.calls == []
     finally:
@@ -77,7 +77,7 @@ def test_another_address_needs_the_token_on_every_request() -> None:
 
 
 def test_a_token_given_is_required_on_loopback_too() -> None:
-    server, sink, operator = start_console(token="s3cret-token")
+    server, sink, _operator = start_console(token="s3cret-token")
     try:
         assert server.url.endswith("/?token=s3cret-token")
         assert request(server.port, "GET", "/api/state")[0] == 401
@@ -106,7 +106,7 @@ def test_control_requests_from_another_origin_are_refused() -> None:
 def test_a_server_that_dies_stops_the_loop() -> None:
     from pipelines.console.sink import ConsoleFailed
     from tests.support import wait_until
-    server, sink, operator = start_console()
+    server, sink, _operator = start_console()
     with FrameFeeder(sink, fps=100) as feeder:
         assert wait_until(lambda: feeder.frames > 3, 5)
         server._loop.call_soon_threadsafe(server._main_task.cancel)
@@ -117,7 +117,7 @@ def test_a_server_that_dies_stops_the_loop() -> None:
 
 def test_stopping_the_server_leaves_the_loop_running() -> None:
     from tests.support import wait_until
-    server, sink, operator = start_console()
+    server, sink, _operator = start_console()
     with FrameFeeder(sink, fps=100) as feeder:
         server.stop()
         count = feeder.frames

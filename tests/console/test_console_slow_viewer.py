@@ -1,6 +1,7 @@
 """A viewer that reads slowly, or not at all, never slows the loop: its frames are dropped."""
 from __future__ import annotations
 
+import itertools
 import time
 
 from tests.console.fakes import FrameFeeder, start_console
@@ -40,7 +41,7 @@ def test_a_stalled_and_a_slow_viewer_leave_the_loop_rate_alone() -> None:
         # the slow reader gets recent frames, not a backlog: frames are skipped for it, and each one
         # it is shown is at most about a second behind the loop (what the socket buffers hold)
         shown = [s for s, _ in seen[1:]]
-        assert all(b - a > 5 for a, b in zip(shown, shown[1:])), seen
+        assert all(b - a > 5 for a, b in itertools.pairwise(shown)), seen
         assert all(handed - s <= RATE for s, handed in seen[1:]), seen
         stalled.close()
         slow.close()
