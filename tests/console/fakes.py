@@ -18,6 +18,7 @@ from pipelines.console import (
 )
 
 SIZE = (640, 360)
+IMAGES = 77  # the bar crosses the frame once in these many frames
 
 
 def view(index: int, t: float) -> ConsoleView:
@@ -73,7 +74,7 @@ class FrameFeeder:
         self.frames = 0
         self.error: BaseException | None = None
         self._stop = threading.Event()
-        self._images = [synthetic_image(i, noisy) for i in range(16)]
+        self._images = [synthetic_image(i, noisy) for i in range(IMAGES)]
         self._thread = threading.Thread(target=self._run, daemon=True)
         self.started = self.ended = 0.0
 
