@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import ipaddress
+import socket
 from dataclasses import dataclass
 
 DEFAULT_HOST = "127.0.0.1"
@@ -42,3 +43,19 @@ def parse_console_address(text: str) -> ConsoleAddress:
     if not 0 <= port <= 65535:
         raise ValueError(f"--console port must be 0 to 65535 (0: any free port), not {port}")
     return ConsoleAddress(host, port)
+
+
+def bind(address: ConsoleAddress) -> socket.socket:
+    """A listening socket on ``address`` (so a port in use is found before a run starts);
+    OSError with the system's reason otherwise."""
+    infos = socket.getaddrinfo(address.host, address.port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    family, kind, proto, _, where = infos[0]
+    sock = socket.socket(family, kind, proto)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind(where)
+        sock.listen(64)
+    except OSError:
+        sock.close()
+        raise
+    return sock

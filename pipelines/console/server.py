@@ -76,8 +76,10 @@ class ConsoleServer:
     so the run stops the gimbal (``ConsoleFailed``)."""
 
     def __init__(self, operator: ConsoleOperator, sink: ConsoleSink, address: ConsoleAddress,
-                 token: str | None = None, max_viewers: int = MAX_VIEWERS) -> None:
+                 token: str | None = None, max_viewers: int = MAX_VIEWERS,
+                 sock: socket.socket | None = None) -> None:
         self.operator = operator
+        self.sock = sock  # already bound to ``address`` (``bind``), or None: bound at start
         self.sink = sink
         self.address = address
         self.guard = Guard(address, token)
@@ -137,7 +139,8 @@ class ConsoleServer:
         runner = web.AppRunner(self.app(), access_log=None, handle_signals=False, shutdown_timeout=1.0)
         await runner.setup()
         try:
-            site = web.TCPSite(runner, self.address.host, self.address.port)
+            site = (web.SockSite(runner, self.sock) if self.sock is not None
+                    else web.TCPSite(runner, self.address.host, self.address.port))
             await site.start()
             self.port = runner.addresses[0][1]
             self._ready.set()

@@ -35,6 +35,8 @@ class ConsoleSink:
     ``ConsoleView`` (a few attribute reads: it runs on the loop's thread); ``dead_zone_px`` gives
     the dead zone's half-width in source pixels as it stands (settings change it)."""
 
+    name = "console"
+
     def __init__(self, describe: Callable[[Any], ConsoleView] = lambda view: view,
                  dead_zone_px: Callable[[], float] = lambda: 0.0, quality: int = JPEG_QUALITY) -> None:
         self._describe = describe
