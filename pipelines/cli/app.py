@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from gimbal.signals import SignalExit, blocked_signals, exit_on_signals
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, hold_on_devnull
+from pipelines.cli.profile import Profile, add_profile_option, apply_profile, blame, profile_path, read_profile
 
 # Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
 SUBCOMMAND_MODULES = [
@@ -25,6 +26,7 @@ SUBCOMMAND_MODULES = [
     "pipelines.cli.sim_cmd",
     "pipelines.cli.gimbal_cmd",
     "pipelines.cli.simulate_cmd",
+    "pipelines.cli.config_cmd",
 ]
 
 
@@ -35,6 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
         "turn its position into yaw/pitch rates, and drive the gimbal over CAN (DJI R SDK).",
     )
     _add_logging_options(parser, False)
+    add_profile_option(parser)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in SUBCOMMAND_MODULES:
         importlib.import_module(name).register(subparsers)
@@ -42,6 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     while pending:  # after the command too, at any depth: gimbaltrack gimbal angles --debug
         subparser = pending.pop()
         _add_logging_options(subparser, argparse.SUPPRESS)
+        add_profile_option(subparser, argparse.SUPPRESS)
         pending += [p for action in subparser._actions if isinstance(action, argparse._SubParsersAction)
                     for p in action.choices.values()]
     return parser
@@ -101,6 +105,8 @@ def _run(argv: list[str] | None, release: Iterable[int] | None, run: _Run) -> in
             finally:
                 if release is not None:  # what arrived while the console script held them comes now
                     signal.pthread_sigmask(signal.SIG_SETMASK, release)
+            given = sys.argv[1:] if argv is None else argv
+            profile = _profile(given, parser, run)
             args = parser.parse_args(argv)
             run.prog, run.debug = f"gimbaltrack {args.command}", args.debug
             level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
@@ -110,7 +116,8 @@ def _run(argv: list[str] | None, release: Iterable[int] | None, run: _Run) -> in
             except CliError as exc:
                 if args.debug:
                     raise
-                print(f"{run.prog}: error: {exc}", file=sys.stderr)
+                message = str(exc) if profile is None else blame(str(exc), profile, given, parser)
+                print(f"{run.prog}: error: {message}", file=sys.stderr)
                 status = exc.exit_code
             return _flushed(run, status)  # here too: a Ctrl-C while a slow reader holds it is handled
     except KeyboardInterrupt:
@@ -124,6 +131,23 @@ def _run(argv: list[str] | None, release: Iterable[int] | None, run: _Run) -> in
         return 0
     except OSError as exc:  # one no subcommand words itself, e.g. stdout on a full disk (> /dev/full)
         return _unwritten(run.prog, exc, run.debug)
+
+
+def _profile(argv: list[str], parser: argparse.ArgumentParser, run: _Run) -> Profile | None:
+    """The rig profile the run uses, applied to the parser's defaults; a bad one ends the run with
+    its one-line error and status 2, as a bad option would."""
+    path = profile_path(argv)
+    if path is None:
+        return None
+    try:
+        profile = read_profile(path, parser)
+    except CliError as exc:
+        if run.debug:
+            raise
+        print(f"{run.prog}: error: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    apply_profile(parser, profile)
+    return profile
 
 
 def _flushed(run: _Run, status: int) -> int:
