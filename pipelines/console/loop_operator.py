@@ -2,7 +2,6 @@
 ``loop.submit`` with a note, which the telemetry line of the frame it ran at carries."""
 from __future__ import annotations
 
-import dataclasses
 import math
 import threading
 import time
@@ -12,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 from gimbal.messages import ParameterPush
 from pipelines.console.operator import ConsoleView
-from pipelines.control import ControlConfig
+from pipelines.control.tuning import retuned, settings_of
 from pipelines.outputs.latency import latency_percentiles
 
 if TYPE_CHECKING:
@@ -24,24 +23,6 @@ CONSOLE_STOP = "stopped from the console"
 SILENT_AFTER_S = 1.0  # no attitude push for this long: the gimbal is silent
 LATENCY_WINDOW = 300  # the status's latency percentiles are over this many recent commands
 FPS_WINDOW_S = 2.0
-#: The console's setting names -> ``ControlConfig`` fields.
-SETTING_FIELDS = {"max_speed": "max_speed_dps", "dead_zone": "deadband_deg", "kp": "kp", "ki": "ki", "kd": "kd"}
-
-
-def retuned(config: ControlConfig, changes: Mapping[str, float]) -> ControlConfig:
-    """``config`` with the console's ``changes``; the acceleration limit is raised only as far as
-    the zero-speed ramp of a new speed limit needs (as ``--max-speed`` does). ValueError from
-    ``ControlConfig`` for a combination it refuses."""
-    fields = {SETTING_FIELDS[name]: value for name, value in changes.items()}
-    if "max_speed_dps" in fields:
-        fields["max_accel_dps2"] = max(config.max_accel_dps2, fields["max_speed_dps"] / config.ramp_s)
-    return dataclasses.replace(config, **fields)
-
-
-def settings_of(config: ControlConfig) -> dict[str, float]:
-    return {name: getattr(config, field) for name, field in SETTING_FIELDS.items()}
-
-
 def describe(record: FrameRecord) -> ConsoleView:
     """What the console shows of one of the loop's records."""
     estimate = record.estimate

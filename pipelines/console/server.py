@@ -123,7 +123,7 @@ class ConsoleServer:
         try:
             self._main_task = loop.create_task(self._main())
             loop.run_until_complete(self._main_task)
-        except BaseException as exc:  # a dying server must stop the run (and the gimbal)
+        except BaseException as exc:  # noqa: BLE001 (a dying server must stop the run and the gimbal)
             if not self._ready.is_set():
                 self._start_error = exc
             else:
