@@ -50,6 +50,7 @@ def draw(image: np.ndarray, view: ConsoleView, scale: float, dead_zone_px: float
     confidence = "" if view.confidence is None else f" conf {view.confidence:.2f}"
     text = (f"#{view.frame_index} {view.state}{confidence} "
             f"yaw {view.rates_dps[0]:+.1f} pitch {view.rates_dps[1]:+.1f} deg/s")
-    (w, h), base = cv2.getTextSize(text, _FONT, 0.5, 1)
+    size = min(0.5, max(0.3, width / 1300))  # the line fits a phone's narrow view too
+    (w, h), base = cv2.getTextSize(text, _FONT, size, 1)
     cv2.rectangle(image, (4, 4), (12 + w, 10 + h + base), (0, 0, 0), cv2.FILLED)
-    cv2.putText(image, text, (8, 8 + h), _FONT, 0.5, (255, 255, 255), 1, cv2.LINE_8)
+    cv2.putText(image, text, (8, 8 + h), _FONT, size, (255, 255, 255), 1, cv2.LINE_8)
