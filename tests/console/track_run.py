@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from tests.support import subprocess_env
-from tests.track.helpers import BOX, make_clip, start, track_command
+from tests.track.helpers import BOX, Position, make_clip, start, track_command
 
 FRAMES = 900  # 30 s at --realtime: the tests stop the run from the console long before
 
@@ -19,16 +19,28 @@ def drifting_slowly(i: int) -> tuple[int, int]:
     return 60 + i // 2, 100
 
 
-def subject_box(frame: int) -> list[int]:
-    x, y = drifting_slowly(frame)
+def subject_box(frame: int, position: Position = drifting_slowly) -> list[int]:
+    x, y = position(frame)
     return [x, y, BOX, BOX]
+
+
+def standing(i: int) -> tuple[int, int]:
+    """A subject that stays where it is, left of centre."""
+    return 60, 100
+
+
+def crossing(i: int) -> tuple[int, int]:
+    """Another thing, crossing the picture right to left and round again (what a motion detector
+    finds first, and the operator corrects)."""
+    return 300 - (3 * i) % 300, 160
 
 
 class ConsoleRun:
     """The run and its console: ``port``, ``url``; ``finish()`` waits for it to end."""
 
-    def __init__(self, tmp_path: Path, *extra: str, console: str = "127.0.0.1:0") -> None:
-        clip = make_clip(tmp_path / "clip.avi", FRAMES, drifting_slowly)
+    def __init__(self, tmp_path: Path, *extra: str, console: str = "127.0.0.1:0",
+                 position: Position = drifting_slowly, other: Position | None = None) -> None:
+        clip = make_clip(tmp_path / "clip.avi", FRAMES, position, other=other)
         self.out = tmp_path / "out"
         self.process = start(track_command(clip, self.out, "--realtime", "--detect", "motion",
                                            "--console", console, *extra), subprocess_env())
