@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-import logging
 import socket
 import threading
 from collections.abc import Awaitable, Callable
@@ -34,7 +33,6 @@ from pipelines.console.security import Guard
 from pipelines.console.sink import ConsoleSink, Snapshot
 from pipelines.outputs._files import to_plain
 
-log = logging.getLogger(__name__)
 
 MAX_VIEWERS = 4
 MAX_EVENT_STREAMS = 8
@@ -115,7 +113,10 @@ class ConsoleServer:
         """Close every connection and the listening socket; the gimbal is not this server's concern."""
         loop, thread = self._loop, self._thread
         if loop is not None and thread is not None and thread.is_alive():
-            loop.call_soon_threadsafe(self._closing.set)
+            try:
+                loop.call_soon_threadsafe(self._closing.set)
+            except RuntimeError:  # it closed meanwhile
+                return
             thread.join(timeout=5.0)
 
     def _serve(self) -> None:
@@ -127,7 +128,6 @@ class ConsoleServer:
             if not self._ready.is_set():
                 self._start_error = exc
             else:
-                log.error("the console server stopped: %s", exc)
                 self.sink.fail(exc)
         finally:
             self._ready.set()

@@ -55,7 +55,8 @@ class ConsoleSink:
         as the newest; wake a viewer waiting for it. Raises ``ConsoleFailed`` once the server
         has died, so the run stops the gimbal."""
         if self.failure is not None:
-            raise ConsoleFailed(f"the console stopped: {self.failure}") from self.failure
+            reason = str(self.failure) or type(self.failure).__name__
+            raise ConsoleFailed(f"the console stopped: {reason}") from self.failure
         image = getattr(frame, "image", frame)
         view = self._describe(record)
         with self._lock:
