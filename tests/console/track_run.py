@@ -39,11 +39,15 @@ class ConsoleRun:
     """The run and its console: ``port``, ``url``; ``finish()`` waits for it to end."""
 
     def __init__(self, tmp_path: Path, *extra: str, console: str = "127.0.0.1:0",
-                 position: Position = drifting_slowly, other: Position | None = None) -> None:
-        clip = make_clip(tmp_path / "clip.avi", FRAMES, position, other=other)
+                 position: Position = drifting_slowly, other: Position | None = None,
+                 source: str | None = None, env: dict[str, str] | None = None) -> None:
+        """A clip of ``position`` (and ``other``) played at its own rate, or ``source`` as given."""
+        if source is None:
+            source = str(make_clip(tmp_path / "clip.avi", FRAMES, position, other=other))
+            extra = ("--realtime", *extra)
         self.out = tmp_path / "out"
-        self.process = start(track_command(clip, self.out, "--realtime", "--detect", "motion",
-                                           "--console", console, *extra), subprocess_env())
+        self.process = start(track_command(source, self.out, "--detect", "motion", "--console", console, *extra),
+                             env or subprocess_env())
         self.stderr_lines: list[str] = []
         for line in self.process.stderr:
             self.stderr_lines.append(line)
