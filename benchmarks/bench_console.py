@@ -7,7 +7,10 @@ clip upscaled when the shared data is absent), in interleaved rounds:
 - B: the same with ``--console 127.0.0.1:0`` and one viewer attached for the whole run, reading
   ``/stream.mjpg`` at the page's defaults (15 fps, 960 px wide).
 
-The loop's fps is the summary's (frames / elapsed). The viewer's latency is, for each MJPEG part,
+The loop's fps is the summary's (frames / elapsed). On a shared machine that figure moves with
+the others' load from one run to the next, so the process's CPU time per frame (user + system,
+from the rusage of the finished run) is printed beside it: the console's cost in CPU, which on
+an idle 2-core machine is what would take fps from the loop. The viewer's latency is, for each MJPEG part,
 its ``X-Capture-Time`` (the frame's time on the machine's monotonic clock) to the moment the whole
 part has been read by the viewer (``time.monotonic()`` in this process: the same clock). With
 ``--realtime`` the clip plays at its own 30 fps instead, as a camera would deliver it. Targets:
@@ -21,6 +24,7 @@ import argparse
 import http.client
 import json
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -69,8 +73,9 @@ class Viewer(threading.Thread):
             connection.close()
 
 
-def track(clip: Path, out: Path, roi: str, console: bool, realtime: bool) -> tuple[float, list[float]]:
-    """The loop's fps and, with the console, the viewer's latencies (s)."""
+def track(clip: Path, out: Path, roi: str, console: bool, realtime: bool) -> tuple[float, float, list[float]]:
+    """The loop's fps, the run's CPU ms per frame and, with the console, the viewer's latencies (s)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     command = [sys.executable, "-m", "pipelines.cli", "track", str(clip), "--out", str(out), "--quiet",
                "--json", "--roi", roi, "--no-video"] + (["--realtime"] if realtime else [])
     if console:
@@ -89,8 +94,10 @@ def track(clip: Path, out: Path, roi: str, console: bool, realtime: bool) -> tup
         sys.exit(f"bench_console: track exited {process.returncode}: {stderr.strip()}")
     if viewer is not None:
         viewer.join(timeout=10)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     summary = json.loads(stdout)
-    return summary["fps"], [latency for _, latency in viewer.parts] if viewer else []
+    cpu_s = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return summary["fps"], cpu_s * 1000.0 / summary["frames"], [latency for _, latency in viewer.parts] if viewer else []
 
 
 def main() -> None:
@@ -105,15 +112,17 @@ def main() -> None:
         folder = Path(tmp)
         clip, roi, origin = make_clip(folder, args.loops, "h264")
         fps: dict[bool, list[float]] = {False: [], True: []}
+        cpu: dict[bool, list[float]] = {False: [], True: []}
         latencies: list[float] = []
         for round_ in range(1, args.rounds + 1):
             for console in (False, True):
-                rate, seen = track(clip, folder / f"out{int(console)}", roi, console, args.realtime)
+                rate, cpu_ms, seen = track(clip, folder / f"out{int(console)}", roi, console, args.realtime)
                 fps[console].append(rate)
+                cpu[console].append(cpu_ms)
                 latencies += seen
-            print(f"round {round_}: without {fps[False][-1]:.1f} fps, with console + 1 viewer "
-                  f"{fps[True][-1]:.1f} fps ({fps[True][-1] / fps[False][-1]:.2f}), "
-                  f"{len(seen)} parts viewed", flush=True)
+            print(f"round {round_}: without {fps[False][-1]:.1f} fps ({cpu[False][-1]:.1f} CPU ms/frame), "
+                  f"with console + 1 viewer {fps[True][-1]:.1f} fps ({cpu[True][-1]:.1f} CPU ms/frame), "
+                  f"fps ratio {fps[True][-1] / fps[False][-1]:.2f}, {len(seen)} parts viewed", flush=True)
         print(describe_machine())
         print(f"clip: {origin}, 1280x720 h264, subject {roi}, {'--realtime' if args.realtime else 'file speed'}, "
               f"{args.rounds} rounds")
@@ -122,6 +131,8 @@ def main() -> None:
         print(f"loop fps median: without {np.median(fps[False]):.1f}, with {np.median(fps[True]):.1f}; "
               f"ratio {ratio:.2f} (per round {ratios.min():.2f}-{ratios.max():.2f}); "
               f"target >= 0.90: {'met' if ratio >= 0.9 else 'MISSED'}")
+        print(f"CPU per frame median: without {np.median(cpu[False]):.1f} ms, with {np.median(cpu[True]):.1f} ms "
+              f"(x{np.median(cpu[True]) / np.median(cpu[False]):.2f})")
         if latencies:
             ms = np.array(latencies) * 1000.0
             p50, p95, p99 = np.percentile(ms, [50, 95, 99])
