@@ -36,6 +36,7 @@ from gimbal.framer import Dropped
 from gimbal.messages import (Message, PayloadError, Reply, decode_message, is_device_push,
                              message_packet, reply_fits, reply_key)
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
+from gimbal.messages.firmware import LEGACY_ORDER_DOCUMENT, check_legacy_order
 from gimbal.messages.external import (FOCUS_CALIBRATION_COMMANDS, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, FocusPositionReply,
                                       JoystickPush)
@@ -191,8 +192,9 @@ class GimbalClient:
 
     def __init__(self, bus: can.BusABC | None = None, *, tx_id: int = HOST_TX_ID,
                  rx_id: int = HOST_RX_ID, timeout: float = 0.1, retries: int = 2,
-                 **bus_kwargs: Any) -> None:
+                 legacy_attitude_order: str = LEGACY_ORDER_DOCUMENT, **bus_kwargs: Any) -> None:
         timeout, retries = _checked_wait(timeout, retries)
+        self.legacy_attitude_order = check_legacy_order(legacy_attitude_order)  # of legacy angle replies
         self._owns_bus = bus is None
         if bus is None:
             try:
@@ -488,7 +490,7 @@ class GimbalClient:
             raise BusError(f"{waiter.request.NAME}: {waiter.error}") from waiter.error
         if waiter.packet is None:
             raise GimbalTimeoutError(f"{waiter.request.NAME}: no reply yet")
-        reply = decode_message(waiter.packet, waiter.request)
+        reply = decode_message(waiter.packet, waiter.request, self.legacy_attitude_order)
         code = getattr(reply, "return_code", None)
         if code is None:
             raise GimbalError(f"{waiter.request.NAME}: answered by {reply.NAME}, not a reply")

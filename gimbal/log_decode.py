@@ -22,6 +22,8 @@ from gimbal.errors import PayloadError, RangeError, UnknownMessageError, describ
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.messages import (Kind, Message, decode_message, is_device_push, is_legacy_reply,
                              reply_fits)
+from gimbal.messages.firmware import (LEGACY_ORDER_DOCUMENT, MISSING_FIELD, check_legacy_order,
+                                      empty_get_request)
 from gimbal.packet import NO_REPLY, Packet, encode_packet
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 
@@ -58,11 +60,14 @@ class LogDecoder:
     counted in ``foreign_frames`` and ignored. Legacy-layout replies (no CmdSet/CmdID) are
     resolved against the commands seen in the other direction: same SEQ first, else the oldest
     command still waiting. A command sent with CmdType policy 0 (no reply wanted) never waits.
+    ``legacy_attitude_order`` is the axis order of legacy angle replies (``gimbal.messages.firmware``).
     """
 
-    def __init__(self, tx_id: int = HOST_TX_ID, rx_id: int = HOST_RX_ID) -> None:
+    def __init__(self, tx_id: int = HOST_TX_ID, rx_id: int = HOST_RX_ID,
+                 legacy_attitude_order: str = LEGACY_ORDER_DOCUMENT) -> None:
         self.tx_id = tx_id
         self.rx_id = rx_id
+        self.legacy_attitude_order = check_legacy_order(legacy_attitude_order)
         self.foreign_frames = 0
         self._framers = {direction: PacketFramer() for direction in (*DIRECTIONS, None)}
         self._outstanding: deque[_Outstanding] = deque(maxlen=MAX_OUTSTANDING)
@@ -112,8 +117,11 @@ class LogDecoder:
         request = None if match is None else match.message
         if legacy and request is not None:
             record["cmd_set"], record["cmd_id"] = request.CMD_SET, request.CMD_ID
+        if direction == HOST_TO_GIMBAL and not packet.is_reply and len(packet.data) >= 2 \
+                and (empty := empty_get_request(packet.cmd_set, packet.cmd_id, packet.payload)) is not None:
+            return self._empty_get_record(record, packet, empty, timestamp)
         try:
-            message = decode_message(packet, request)
+            message = decode_message(packet, request, self.legacy_attitude_order)
         except UnknownMessageError as exc:
             reason = "unmatched_legacy_reply" if legacy and request is None else "unknown_command"
             return {**record, "error": reason, "detail": str(exc), "hex": _hex(packet)}
@@ -136,6 +144,17 @@ class LogDecoder:
             self._outstanding.append(_Outstanding(packet.seq, message, timestamp))
         record["hex"] = _hex(packet)
         return record
+
+    def _empty_get_record(self, record: Record, packet: Packet, request: type[Message],
+                          timestamp: float | None) -> Record:
+        """A get request sent without its payload, as some public drivers send them: named, and
+        waiting for its reply, but marked as outside the document rather than as damaged."""
+        if packet.reply_policy != NO_REPLY:
+            self._outstanding.append(_Outstanding(packet.seq, request(), timestamp))
+        return {**record, "name": request.NAME, "kind": Kind.COMMAND.value, "fields": {},
+                "outside_document": f"{request.NAME} without its payload (the document defines "
+                                    f"{MISSING_FIELD[request]}); some public drivers send it so",
+                "hex": _hex(packet)}
 
     def _take_request(self, packet: Packet, legacy: bool, timestamp: float | None) -> _Outstanding | None:
         """Remove and return the outstanding command a reply answers, if any was seen."""
@@ -180,10 +199,10 @@ def _hex(packet: Packet) -> str:
     return (packet.raw or encode_packet(packet)).hex(" ")
 
 
-def decode_frames(frames: Iterable[can.Message], tx_id: int = HOST_TX_ID,
-                  rx_id: int = HOST_RX_ID) -> Iterator[Record]:
+def decode_frames(frames: Iterable[can.Message], tx_id: int = HOST_TX_ID, rx_id: int = HOST_RX_ID,
+                  legacy_attitude_order: str = LEGACY_ORDER_DOCUMENT) -> Iterator[Record]:
     """Records for a whole sequence of frames, ending with whatever was left truncated."""
-    decoder = LogDecoder(tx_id, rx_id)
+    decoder = LogDecoder(tx_id, rx_id, legacy_attitude_order)
     last = None
     for frame in frames:
         last = frame.timestamp
@@ -191,8 +210,9 @@ def decode_frames(frames: Iterable[can.Message], tx_id: int = HOST_TX_ID,
     yield from decoder.finish(last)
 
 
-def decode_log_file(path: str, tx_id: int = HOST_TX_ID, rx_id: int = HOST_RX_ID) -> Iterator[Record]:
+def decode_log_file(path: str, tx_id: int = HOST_TX_ID, rx_id: int = HOST_RX_ID,
+                    legacy_attitude_order: str = LEGACY_ORDER_DOCUMENT) -> Iterator[Record]:
     """Records for a CAN log in any format ``can.LogReader`` reads (.log, .asc, .blf, .csv, .trc,
     ...). Opening raises ``OSError``/``ValueError`` for a missing file or unknown format; reading
     errors of a corrupt file propagate from python-can."""
-    return decode_frames(can.LogReader(path), tx_id, rx_id)
+    return decode_frames(can.LogReader(path), tx_id, rx_id, legacy_attitude_order)

@@ -13,6 +13,8 @@ from gimbal.messages.motion import *  # noqa: F401,F403
 from gimbal.messages.settings import *  # noqa: F401,F403
 from gimbal.messages.telemetry import *  # noqa: F401,F403
 from gimbal.messages.tlv_params import *  # noqa: F401,F403
+from gimbal.messages.firmware import (LEGACY_ORDER_DOCUMENT, LEGACY_ORDERS, is_angles_reply_key,
+                                      legacy_angles_payload)
 from gimbal.packet import NO_REPLY, REPLY_REQUIRED, Packet
 
 
@@ -60,11 +62,13 @@ def reply_fits(request: type[Message] | Message, packet: Packet) -> bool:
     return isinstance(request, type) or request.reply_is_mine(payload)
 
 
-def decode_message(packet: Packet, request: type[Message] | Message | None = None) -> Message:
+def decode_message(packet: Packet, request: type[Message] | Message | None = None,
+                   legacy_order: str = LEGACY_ORDER_DOCUMENT) -> Message:
     """The typed message a packet carries.
 
     Pushes are classified by CmdSet/CmdID whatever the reply bit says (some firmware sets it on
-    pushes). A legacy reply needs ``request``, the command it answers (class or instance).
+    pushes). A legacy reply needs ``request``, the command it answers (class or instance);
+    ``legacy_order`` is the axis order of legacy angle replies (``gimbal.messages.firmware``).
     Raises ``PayloadError`` (or its subclass ``UnknownMessageError``).
     """
     data = packet.data
@@ -73,14 +77,14 @@ def decode_message(packet: Packet, request: type[Message] | Message | None = Non
     if pushes is not None:  # is_device_push(packet), with the candidates at hand
         return _pick(pushes, data[2:], f"push 0x{key[0]:02X}/0x{key[1]:02X}").decode_payload(data[2:])
     if packet.is_reply:
-        return _decode_reply(packet, request)
+        return _decode_reply(packet, request, legacy_order)
     candidates = HOST_MESSAGES.get(key) if key is not None else None
     if candidates is None:
         raise UnknownMessageError(f"command {data[:2].hex(' ') or '(empty)'} is not defined by the document")
     return _pick(candidates, data[2:], f"command 0x{key[0]:02X}/0x{key[1]:02X}").decode_payload(data[2:])
 
 
-def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Message:
+def _decode_reply(packet: Packet, request: type[Message] | Message | None, legacy_order: str) -> Message:
     key = reply_key(packet)
     if key is not None:
         payload = packet.data[2:]
@@ -88,6 +92,8 @@ def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Me
         raise UnknownMessageError("legacy-layout reply (no CmdSet/CmdID) without the command it answers")
     else:
         key, payload = (request.CMD_SET, request.CMD_ID), packet.data
+        if is_angles_reply_key(key):
+            payload = legacy_angles_payload(payload, legacy_order)
     expected = getattr(request, "REPLY", None)
     if expected is not None and (expected.CMD_SET, expected.CMD_ID) == key:
         if not reply_fits(request, packet):
@@ -100,18 +106,22 @@ def _decode_reply(packet: Packet, request: type[Message] | Message | None) -> Me
 
 
 def message_packet(message: Message, seq: int, cmd_type: int | None = None,
-                   legacy: bool = False) -> Packet:
+                   legacy: bool = False, legacy_order: str = LEGACY_ORDER_DOCUMENT) -> Packet:
     """Wrap a message in a packet. Commands want a reply when the document defines one; pushes
-    want none; ``legacy`` builds a reply in the old layout."""
+    want none, and ``cmd_type`` may set the reply bit on them as some firmware does; ``legacy``
+    builds a reply in the old layout, angle replies in ``legacy_order``."""
     payload = message.encode_payload()
     if message.KIND is Kind.REPLY:
+        if legacy and is_angles_reply_key((message.CMD_SET, message.CMD_ID)):
+            payload = legacy_angles_payload(payload, legacy_order)
         return Packet.reply(message.CMD_SET, message.CMD_ID, payload, seq, legacy=legacy)
     if cmd_type is None:
         cmd_type = REPLY_REQUIRED if message.REPLY is not None else NO_REPLY
     return Packet.command(message.CMD_SET, message.CMD_ID, payload, seq, cmd_type)
 
 
-__all__ = ["CAMERA_CMD_SET", "GIMBAL_CMD_SET", "Command", "DevicePush", "HostPush", "Kind", "Message",
+__all__ = ["CAMERA_CMD_SET", "GIMBAL_CMD_SET", "LEGACY_ORDERS", "LEGACY_ORDER_DOCUMENT", "Command",
+           "DevicePush", "HostPush", "Kind", "Message",
            "PayloadError", "Reply", "ReturnCodeReply", "Sender", "Tlv", "UnknownMessageError",
            "all_message_classes", "decode_message", "is_device_push", "is_legacy_reply", "message_packet",
            "reply_fits", "reply_key"]

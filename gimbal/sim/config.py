@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from gimbal.messages.firmware import LEGACY_ORDER_DOCUMENT, LEGACY_ORDERS
 from gimbal.messages.telemetry import DEVICE_ID_R_SDK, DEVICE_ID_RANGE
 from gimbal.sim.checks import FieldError, check
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
@@ -16,6 +17,9 @@ class SimConfig:
     rx_id: int = HOST_TX_ID  # the device listens where the host sends (0x223)
     tx_id: int = HOST_RX_ID  # and answers where the host listens (0x222)
     legacy: bool = False  # old firmware: replies omit CmdSet/CmdID
+    legacy_attitude_order: str = LEGACY_ORDER_DOCUMENT  # axis order of legacy angle replies ("ypr": ArduPilot's)
+    push_reply_bit: bool = False  # pushes (0x08, 0x10) with CmdType 0x20, as some firmware sends them
+    lenient: bool = False  # answer get requests that come without their payload (limits, stiffness, user params)
     push_rate_hz: float = 50.0  # parameter push (0x08) rate once enabled
     tick_hz: float = 200.0  # the grain of injected foreign traffic (everything else is sent when due)
     max_speed_dps: float = 360.0
@@ -56,6 +60,8 @@ _FLAG = "True or False"
 RULES = {
     "rx_id": _CAN_ID, "tx_id": _CAN_ID,
     "legacy": (_FLAG, is_flag), "yaw_continuous": (_FLAG, is_flag), "camera_connected": (_FLAG, is_flag),
+    "push_reply_bit": (_FLAG, is_flag), "lenient": (_FLAG, is_flag),
+    "legacy_attitude_order": (f"one of {', '.join(LEGACY_ORDERS)}", lambda v: v in LEGACY_ORDERS),
     "push_rate_hz": _PUSH_RATE,
     "tick_hz": (_RATE, number(0, above=True)),
     "max_speed_dps": (_SPEED, number(0, above=True)),

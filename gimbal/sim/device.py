@@ -14,7 +14,8 @@ import can
 
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.messages import Kind, Message, Sender, decode_message, message_packet
-from gimbal.packet import Packet, encode_packet
+from gimbal.messages.firmware import empty_get_request
+from gimbal.packet import REPLY_CMD_TYPE, Packet, encode_packet
 from gimbal.sim.config import SimConfig
 from gimbal.sim.faults import FaultInjector, Faults
 from gimbal.sim.model import GimbalModel
@@ -130,7 +131,7 @@ class SimulatedGimbal:
             return
         wants_reply = packet.reply_policy >= 1
         try:
-            message = decode_message(packet)
+            message = self._lenient_get(packet) or decode_message(packet)
             message.validate()
         except ValueError as exc:  # PayloadError, RangeError
             self._discarded["unparsable"] += 1
@@ -150,7 +151,19 @@ class SimulatedGimbal:
         reply = self._model.handle(message, now) if code is None else self._model.refuse(message, code)
         self._wake_if_sooner()  # e.g. the push turned on, a calibration started
         if wants_reply:
-            self._queue(message_packet(reply, packet.seq, legacy=self._legacy()), reply.NAME, now)
+            self._queue(message_packet(reply, packet.seq, legacy=self._legacy(),
+                                       legacy_order=self.config.legacy_attitude_order), reply.NAME, now)
+
+    def _lenient_get(self, packet: Packet) -> Message | None:
+        """In lenient mode, a get request without its payload as the request with the document's
+        defaults (ctrl_byte 1; the user parameters this project reads); None otherwise."""
+        if not self.config.lenient or len(packet.data) < 2:
+            return None
+        request = empty_get_request(packet.cmd_set, packet.cmd_id, packet.payload)
+        if request is None:
+            return None
+        self._discarded["empty_get_requests"] += 1
+        return request()
 
     def _legacy(self) -> bool:
         return self._injector.legacy_reply() or self.config.legacy
@@ -188,7 +201,8 @@ class SimulatedGimbal:
 
     def _push(self, message: Message, now: float) -> None:
         self._push_seq = (self._push_seq + 1) & 0xFFFF
-        self._send(message_packet(message, self._push_seq), message.NAME, now, "pushes")
+        cmd_type = REPLY_CMD_TYPE if self.config.push_reply_bit else None
+        self._send(message_packet(message, self._push_seq, cmd_type), message.NAME, now, "pushes")
 
     # --- tick ---------------------------------------------------------------------------------
 

@@ -37,7 +37,8 @@ def open_host_bus(args: argparse.Namespace) -> Iterator[can.BusABC]:
     try:
         yield bus
     finally:
-        bus.shutdown()
+        if not bus._is_shutdown:  # a LoggingBus around it shut it down; slcan's second shutdown raises
+            bus.shutdown()
 
 
 def open_can_bus(options: dict[str, Any]) -> can.BusABC:

@@ -18,6 +18,7 @@ import can
 from gimbal.log_decode import GIMBAL_TO_HOST, HOST_TO_GIMBAL, LogDecoder
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID
 from pipelines.cli.common import CliError, parse_int
+from pipelines.cli.firmware_opts import add_legacy_order_option
 
 _DIRECTION_ALIASES = {"host": HOST_TO_GIMBAL, "gimbal": GIMBAL_TO_HOST, HOST_TO_GIMBAL: HOST_TO_GIMBAL,
                       GIMBAL_TO_HOST: GIMBAL_TO_HOST}
@@ -45,6 +46,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help=f"CAN id the host sends on (default 0x{HOST_TX_ID:03X})")
     parser.add_argument("--rx-id", type=parse_int, default=HOST_RX_ID,
                         help=f"CAN id the gimbal answers on (default 0x{HOST_RX_ID:03X})")
+    add_legacy_order_option(parser)
     parser.set_defaults(func=run)
 
 
@@ -62,7 +64,7 @@ def parse_hex(text: str) -> bytes:
 
 def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
     out = out or sys.stdout
-    decoder = LogDecoder(args.tx_id, args.rx_id)
+    decoder = LogDecoder(args.tx_id, args.rx_id, args.legacy_order)
     if args.hex is not None:
         direction = _DIRECTION_ALIASES[args.direction] if args.direction else None
         data = b"".join(parse_hex(text) for text in args.hex)

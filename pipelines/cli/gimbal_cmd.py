@@ -33,6 +33,7 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
 from pipelines.cli.bus import open_host_bus
+from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import (CliError, add_bus_options, hold_on_devnull, parse_int, parse_seconds,
                                   suppress_defaults)
 
@@ -525,6 +526,7 @@ def _shared_options(parser: argparse.ArgumentParser, repeated: bool = False) -> 
               parser.add_argument("--timeout", type=float, default=0.1,
                                   help="reply timeout in s (default 0.1)")]
     add_bus_options(parser, repeated=repeated)
+    add_legacy_order_option(parser, repeated=repeated)
     if repeated:
         suppress_defaults(shared)
 
@@ -546,7 +548,8 @@ def run(command: Command, args: argparse.Namespace) -> int:
             raise CliError(f"--timeout must be a number of seconds above 0 (at most {MAX_TIMEOUT:.0f}), "
                            f"not {args.timeout:g}")
         with open_host_bus(args) as bus, \
-                GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id, timeout=args.timeout) as client:
+                GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id, timeout=args.timeout,
+                             legacy_attitude_order=args.legacy_order) as client:
             result = command.run(client, args)
     except RangeError as exc:
         raise CliError(str(exc)) from None

@@ -43,7 +43,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "gimbal": {"invert_yaw": Key("--invert-yaw"), "invert_pitch": Key("--invert-pitch"),
                "invert_yaw_attitude": Key("--invert-yaw-attitude"),
                "invert_pitch_attitude": Key("--invert-pitch-attitude"),
-               "attitude_feedback": Key("--attitude-feedback")},
+               "attitude_feedback": Key("--attitude-feedback"), "legacy_order": Key("--legacy-order")},
     "camera": {"hfov": Key("--hfov")},
     "control": {"controller": Key("--controller"), "rate": Key("--rate"), "max_speed": Key("--max-speed")},
     "tracker": {"tracker": Key("--tracker"), "model_dir": Key("--model-dir"), "detect": Key("--detect"),

@@ -23,6 +23,7 @@ from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
 from gimbal.transport import CanTransport, packet_frames
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
+from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.decode_cmd import _close, _open_log, check_log_path, iter_log_frames
 from pipelines.cli.sim_cmd import status_line
 
@@ -55,6 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--speed", type=float, default=1.0, metavar="X",
                         help="playback speed factor for --realtime and bus output (default 1)")
     add_bus_options(parser)
+    add_legacy_order_option(parser)
     parser.set_defaults(func=run)
 
 
@@ -247,7 +249,7 @@ def _settled(sim: Any) -> Any:
 
 
 def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | None, out: TextIO) -> None:
-    decoder = LogDecoder(args.tx_id, args.rx_id)
+    decoder = LogDecoder(args.tx_id, args.rx_id, args.legacy_order)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
     skip_echoes = _marks_sent_frames(args.log, args.tx_id)
     with closing(iter_log_frames(args.log, "replay")) as frames:

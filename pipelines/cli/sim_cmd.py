@@ -17,8 +17,10 @@ from gimbal.sim import Faults, SimConfig, SimState, SimulatedGimbal
 from gimbal.sim.checks import FieldError
 from gimbal.sim.config import MAX_PUSH_RATE_HZ
 from gimbal.sim.faults import DIRECTIONS
+from gimbal.sim.slcan_pty import SlcanPty, virtual_pair
 from pipelines.cli.bus import SIM_INTERFACE, bus_options, check_sim_ids, open_can_bus
 from pipelines.cli.common import CliError, add_bus_options, parse_int, parse_seconds
+from pipelines.cli.firmware_opts import add_legacy_order_option
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -30,8 +32,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "'gimbaltrack sim -i udp_multicast -c 239.74.163.2'. The id options keep the host's point of "
         "view: the simulator listens on --tx-id and answers on --rx-id.")
     add_bus_options(parser, default_interface="udp_multicast", offers_sim=False)
+    parser.add_argument("--slcan-pty", action="store_true",
+                        help="instead of -i/-c/-b: be a USB-CAN adapter speaking SLCAN on a pseudo-terminal "
+                        "whose path is printed first on standard output; drive it with '-i slcan -c PATH'")
     model = parser.add_argument_group("device")
     model.add_argument("--legacy", action="store_true", help="old firmware: replies omit CmdSet/CmdID")
+    add_legacy_order_option(model)
+    model.add_argument("--push-reply-bit", action="store_true",
+                       help="send the parameter and calibration pushes with CmdType 0x20, as some firmware does")
+    model.add_argument("--lenient", action="store_true",
+                       help="answer get requests for limits, stiffness and user parameters sent without "
+                       "their payload (default: refused as a parse error, 0x01)")
     model.add_argument("--push-rate", type=float, default=SimConfig.push_rate_hz, metavar="HZ",
                        help=f"parameter push rate once enabled, above 0 up to {MAX_PUSH_RATE_HZ:g} (default %(default)s)")
     model.add_argument("--accel", type=float, default=SimConfig.accel_dps2, metavar="DPS2",
@@ -122,6 +133,8 @@ def build(args: argparse.Namespace) -> tuple[SimConfig, Faults]:
     check_sim_ids(args)  # in the options' words, before SimConfig's own check of the same
     try:
         config = SimConfig(rx_id=args.tx_id, tx_id=args.rx_id, legacy=args.legacy,
+                           legacy_attitude_order=args.legacy_order, push_reply_bit=args.push_reply_bit,
+                           lenient=args.lenient,
                            push_rate_hz=args.push_rate, accel_dps2=args.accel, base_yaw_deg=args.base_yaw,
                            yaw_continuous=args.yaw_continuous, version=args.version,
                            calibration_s=args.calibration_time, camera_connected=not args.no_camera,
@@ -150,7 +163,12 @@ def _given(value: float | tuple[float, float]) -> str:
     return str(value) if isinstance(value, int) else f"{value:g}"
 
 
-def open_bus(args: argparse.Namespace) -> can.BusABC:
+def open_bus(args: argparse.Namespace) -> can.BusABC | None:
+    """The bus the simulator answers on; None for --slcan-pty (``run`` makes that one)."""
+    if args.slcan_pty:
+        if args.channel is not None or args.bitrate is not None or args.interface != "udp_multicast":
+            raise CliError("--slcan-pty is the bus: it takes no -i/--interface, -c/--channel or -b/--bitrate")
+        return None
     if args.interface == SIM_INTERFACE:
         raise CliError("'-i sim' is the in-process simulator; give 'sim' a real bus, e.g. -i udp_multicast")
     return open_can_bus(bus_options(args))
@@ -170,6 +188,11 @@ def status_line(state: SimState, elapsed: float) -> str:
 def run(args: argparse.Namespace) -> int:
     config, faults = build(args)
     bus = open_bus(args)
+    adapter: SlcanPty | None = None
+    if bus is None:  # --slcan-pty: the gimbal on one end of a virtual bus, the adapter on the other
+        adapter_bus, bus = virtual_pair()
+        adapter = SlcanPty(adapter_bus).start()
+        print(adapter.path, flush=True)
     stop = threading.Event()
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
@@ -197,5 +220,8 @@ def run(args: argparse.Namespace) -> int:
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
+        if adapter is not None:
+            adapter.stop()
+            adapter.bus.shutdown()
         bus.shutdown()
     return 0

@@ -17,6 +17,7 @@ from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit, deferred_signals
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
+from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
@@ -105,6 +106,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--quiet", action="store_true", help="no progress line")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_bus_options(parser, default_interface="sim")
+    add_legacy_order_option(parser)
     parser.set_defaults(func=run_track)
 
 
@@ -171,7 +173,8 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             can_log = _can_log(options.out_dir / "can.log")
             try:
                 with LoggingBus(bus, can_log) as logged, \
-                        GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id) as client:
+                        GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id,
+                                     legacy_attitude_order=args.legacy_order) as client:
                     where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
                              " ".join(str(v) for v in (args.interface or "python-can's configured bus",
                                                        args.channel) if v))

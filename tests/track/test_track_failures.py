@@ -6,6 +6,7 @@ from __future__ import annotations
 import errno
 import json
 import signal
+import threading
 import time
 from pathlib import Path
 
@@ -166,8 +167,13 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
     sim = start(cli_command("sim", "-i", "udp_multicast", "-c", GROUP, "--status-interval", "0.1", "--json"),
                 env)
     out = tmp_path / "out"
+    # Read the status lines as they come: a pipe left unread fills (~10 s at 10 lines/s) and stalls
+    # the simulator, whose last line would then be an old one from mid-run.
+    sim_lines: list[str] = []
+    reader = threading.Thread(target=lambda: sim_lines.extend(sim.stdout), daemon=True)  # type: ignore[arg-type]
+    reader.start()
     try:
-        _wait_for(lambda: sim.stdout.readline() != "", 10, "the simulator")  # type: ignore[union-attr]
+        _wait_for(lambda: sim_lines, 30, "the simulator")
         track = start(track_command(DEMO, out, "--roi", DEMO_ROI, "--realtime", "-i", "udp_multicast",
                                     "-c", GROUP), env)
         telemetry = out / "telemetry.jsonl"
@@ -182,7 +188,8 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
         time.sleep(0.5)  # the simulator decelerates (720 deg/s^2) and reports every 0.1 s
     finally:
         sim.send_signal(signal.SIGTERM)
-        sim_out, _ = sim.communicate(timeout=10)
+        sim.wait(timeout=10)
+        reader.join(timeout=10)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == status and status in stdout
     frames = summary["frames"]
@@ -191,7 +198,7 @@ def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: l
     records = decoded(out / "can.log")
     assert any(not c.zero for c in speed_commands(records)), "the gimbal never moved"
     assert_stopped_at_end(records)
-    final = json.loads(sim_out.strip().splitlines()[-1])
+    final = json.loads(sim_lines[-1])
     assert final["speeds"] == [0.0, 0.0, 0.0] and not final["moving"] and not final["speed_control"]
 
 
