@@ -12,23 +12,42 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
 
 import can
 
-from gimbal.client import DEFAULT_MAX_AGE_S, SPEED_HOLD, GimbalClient, PendingReply
 from gimbal.errors import BusError, GimbalError, SendError
-from gimbal.messages.motion import SpeedControl, finite_number, to_raw
+from gimbal.messages import Message, Reply
+from gimbal.messages.limits import MAX_SPEED_DPS, SPEED_COMMAND_LASTS_S
+from gimbal.messages.motion import SPEED_HOLD, SpeedControl, finite_number, to_raw
+
+if TYPE_CHECKING:
+    from gimbal.matcher import PendingReply
 
 log = logging.getLogger(__name__)
 
-MAX_SPEED_DPS = 360.0
-STAT_KEYS = ("sent", "zero_sent", "replies", "reply_errors", "reply_timeouts", "send_errors")  # from the start
-MIN_RATE_HZ = 4.0  # at least two sends inside the gimbal's 0.5 s window
+DEFAULT_MAX_AGE_S = 0.3  # a setpoint this old is replaced by zero speed
+STAT_KEYS = ("sent", "zero_sent", "replies", "late_replies", "reply_errors", "reply_timeouts",
+             "send_errors")  # from the start
+MIN_RATE_HZ = 2 / SPEED_COMMAND_LASTS_S  # at least two sends inside the time one command lasts
 MAX_RATE_HZ = 50.0  # public drivers use 10-50 Hz; a new setpoint may go out at twice the rate, and
 # each reply (a few ms) must be back by the next send, half a period later at the least
+
+
+class SpeedSender(Protocol):
+    """What the keep-alive needs from a client: send a command without waiting, collect or drop
+    its reply, and the safety stop."""
+
+    def submit(self, message: Message) -> PendingReply: ...
+
+    def cancel(self, waiter: PendingReply) -> None: ...
+
+    def result(self, waiter: PendingReply) -> Reply: ...
+
+    def stop_and_release(self) -> None: ...
 
 
 @dataclass
@@ -50,13 +69,15 @@ class SpeedStreamer:
 
     A setpoint older than ``max_age`` seconds (since ``set()``, on ``clock``) is never resent:
     zero speed goes out instead, so a stalled tracker stops the gimbal. Reply errors, reply
-    timeouts and sends the bus refused (a full transmit queue) are counted in ``stats``;
-    ``max_missed_replies`` consecutive speed commands without a reply, timed out or not sent,
-    mean the bus (or gimbal) is lost: streaming stops, a best-effort stop is sent, ``error`` is
-    set and the next ``set()`` raises ``BusError``.
+    timeouts and sends the bus refused (a full transmit queue) are counted in ``stats``; so are
+    replies that came after their command's window (``late_replies``: a slow link, e.g.
+    ``gimbaltrack sim --delay-ms 150``), which show the gimbal hears us. ``max_missed_replies``
+    consecutive speed commands without a reply, timed out or not sent, and no late reply
+    meanwhile, mean the bus (or gimbal) is lost: streaming stops, a best-effort stop is sent,
+    ``error`` is set and the next ``set()`` raises ``BusError``.
     """
 
-    def __init__(self, client: GimbalClient, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S, *,
+    def __init__(self, client: SpeedSender, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S, *,
                  max_missed_replies: int = 10, clock: Callable[[], float] = time.monotonic) -> None:
         if not MIN_RATE_HZ <= rate_hz <= MAX_RATE_HZ:
             raise ValueError(f"the keep-alive rate must be {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz (a command "
@@ -74,6 +95,7 @@ class SpeedStreamer:
         self._setpoint: _Setpoint | None = None
         self._latencies: list[float] = []
         self._missed = 0
+        self._overdue: deque[PendingReply] = deque(maxlen=max_missed_replies)  # timed out, may yet be answered
         self._halt = threading.Event()
         self._wake = threading.Event()  # a new setpoint: send it now rather than at the next tick
         self._stopped = False
@@ -184,6 +206,16 @@ class SpeedStreamer:
                 self._latencies.append(self._clock() - setpoint.stamp)
         return pending
 
+    def _count_late_replies(self) -> None:
+        """Commands that timed out but were answered since: the gimbal hears us, only slowly."""
+        answered = [waiter for waiter in self._overdue if waiter.done]
+        if not answered:
+            return
+        for waiter in answered:
+            self._overdue.remove(waiter)
+        self.stats["late_replies"] += sum(waiter.late for waiter in answered)
+        self._missed = 0
+
     def _count_miss(self, what: str) -> None:
         """One more speed command in a row without a reply; ``max_missed_replies`` = bus lost."""
         self._missed += 1
@@ -193,11 +225,13 @@ class SpeedStreamer:
 
     def _collect(self, pending: PendingReply | None) -> None:
         """Account for the previous tick's reply; too many missing in a row = bus lost."""
+        self._count_late_replies()
         if pending is None:
             return
         self._client.cancel(pending)
         if not pending.done:
             self.stats["reply_timeouts"] += 1
+            self._overdue.append(pending)
             self._count_miss("timed out")
             return
         self._missed = 0

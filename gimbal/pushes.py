@@ -9,7 +9,10 @@ from collections.abc import Callable
 from typing import TypeVar
 
 from gimbal.errors import GimbalError, GimbalTimeoutError
-from gimbal.messages import Kind, Message, Sender
+from gimbal.messages import Kind, Message, Sender, decode_message, is_device_push
+from gimbal.packet import Packet
+from gimbal.packet_listener import PacketListener
+from gimbal.transport import HOST_RX_ID
 
 log = logging.getLogger(__name__)
 
@@ -28,12 +31,16 @@ def _check_push_class(cls: type[Message]) -> None:
                          "(e.g. ParameterPush, CalibrationStatusPush)")
 
 
-class PushHub:
-    """Keeps the latest push of each class with its arrival time (``time.monotonic()``) and calls
-    subscribers. A subscriber that raises an ``Exception`` is logged and stays subscribed; one that
-    raises SystemExit ends the delivering thread (``CallbackExit``)."""
+class PushHub(PacketListener):
+    """A ``can.Listener`` that decodes the device pushes among the frames on ``rx_id``, keeps the
+    latest of each class with its arrival time (``time.monotonic()``) and calls subscribers.
+    A subscriber that raises an ``Exception`` is logged and stays subscribed; one that raises
+    SystemExit ends the delivering thread (``CallbackExit``). ``stats`` counts ``pushes`` and
+    undecodable ones (``bad_pushes``)."""
 
-    def __init__(self) -> None:
+    def __init__(self, rx_id: int = HOST_RX_ID, stats: Counter[str] | None = None) -> None:
+        super().__init__(rx_id)
+        self.stats: Counter[str] = Counter() if stats is None else stats
         self._cond = threading.Condition()
         self._latest: dict[type[Message], tuple[Message, float]] = {}
         self._counts: Counter[type[Message]] = Counter()
@@ -52,6 +59,18 @@ class PushHub:
                 if callback in callbacks:
                     callbacks.remove(callback)
         return unsubscribe
+
+    def on_packet(self, packet: Packet, t: float) -> None:
+        if not is_device_push(packet) or self._interrupted is not None:
+            return  # the reply matcher's, or after the end (a lost bus: the Notifier runs on until close)
+        try:
+            message = decode_message(packet)
+        except GimbalError as exc:
+            self.stats["bad_pushes"] += 1
+            log.warning("undecodable push: %s", exc)
+            return
+        self.stats["pushes"] += 1
+        self.deliver(message, t)
 
     def deliver(self, message: Message, t: float) -> None:
         """Record one push and run its subscribers (on the caller's thread)."""

@@ -4,16 +4,13 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 from gimbal.errors import RangeError
 from gimbal.messages.base import GIMBAL_CMD_SET, register
 from gimbal.messages.kinds import Command, Reply, ReturnCodeReply
-
-YAW_ANGLE_RANGE = (-1800, 1800)
-ROLL_ANGLE_RANGE = (-300, 300)
-PITCH_ANGLE_RANGE = (-560, 1460)
-SPEED_RANGE = (-3600, 3600)  # the document gives 0..360 °/s as a magnitude; the sign is direction
+from gimbal.messages.limits import (ANGLE_RANGES, PITCH_ANGLE_RANGE, ROLL_ANGLE_RANGE, SPEED_RANGE,
+                                    TENTHS, TIME_RANGE, YAW_ANGLE_RANGE)
 DECI_DEGREE = (0.1, "°")
 DECI_DEGREE_PER_S = (0.1, "°/s")
 DECI_SECOND = (0.1, " s")
@@ -24,13 +21,14 @@ POSITION_ROLL_INVALID = 0x04
 POSITION_PITCH_INVALID = 0x08
 SPEED_TAKE_CONTROL = 0x80  # bit 7: 1 take, 0 release speed control
 SPEED_IGNORE_FOCAL_LENGTH = 0x08  # bit 3: speed does not depend on the camera's focal length
+SPEED_HOLD = SPEED_TAKE_CONTROL | SPEED_IGNORE_FOCAL_LENGTH  # 0x88: in control
+SPEED_RELEASE = SPEED_IGNORE_FOCAL_LENGTH  # 0x08: bit 7 clear, control released
 
 ANGLES_NONE = 0x00
 ANGLES_ATTITUDE = 0x01
 ANGLES_JOINT = 0x02
 
 AXES = ("yaw", "roll", "pitch")  # the axis order of position, speed and angle messages
-ANGLE_RANGES = {"yaw": YAW_ANGLE_RANGE, "roll": ROLL_ANGLE_RANGE, "pitch": PITCH_ANGLE_RANGE}
 POSITION_INVALID = {"yaw": POSITION_YAW_INVALID, "roll": POSITION_ROLL_INVALID,
                     "pitch": POSITION_PITCH_INVALID}  # ctrl_byte bit that leaves the axis alone
 
@@ -46,12 +44,25 @@ def finite_number(value: float, name: str) -> float:
 
 def to_raw(value: float, name: str) -> int:
     """Degrees (or °/s, or s) to the wire's 0.1 units, rounded to the nearest unit."""
-    return round(finite_number(value, name) * 10)
+    return round(finite_number(value, name) * TENTHS)
 
 
 def from_raw(raw: int) -> float:
     """The wire's 0.1 units to degrees (or °/s, or s)."""
-    return raw / 10
+    return raw / TENTHS
+
+
+class AxisDegrees(NamedTuple):
+    """Three angles in degrees, in the document's axis order: what a reply or push carries in
+    0.1° units, converted once here so that no reader converts raw units itself."""
+
+    yaw: float
+    roll: float
+    pitch: float
+
+    @classmethod
+    def from_raw(cls, yaw: int, roll: int, pitch: int) -> AxisDegrees:
+        return cls(from_raw(yaw), from_raw(roll), from_raw(pitch))
 
 
 @register
@@ -72,7 +83,8 @@ class PositionControl(Command):
     NAME: ClassVar[str] = "position_control"
     FORMAT: ClassVar[str] = "hhhBB"
     RANGES: ClassVar = {"yaw_angle": YAW_ANGLE_RANGE, "roll_angle": ROLL_ANGLE_RANGE,
-                        "pitch_angle": PITCH_ANGLE_RANGE, "ctrl_byte": (0, 0x0F)}
+                        "pitch_angle": PITCH_ANGLE_RANGE, "ctrl_byte": (0, 0x0F),
+                        "time_for_action": TIME_RANGE}
     UNITS: ClassVar = {"yaw_angle": DECI_DEGREE, "roll_angle": DECI_DEGREE, "pitch_angle": DECI_DEGREE,
                        "time_for_action": DECI_SECOND}
     REPLY: ClassVar = PositionControlReply
@@ -126,6 +138,13 @@ class AnglesReply(Reply):
     yaw: int | None = None
     roll: int | None = None
     pitch: int | None = None
+
+    @property
+    def degrees(self) -> AxisDegrees | None:
+        """The angles in degrees; None when the reply stops short of them."""
+        if self.yaw is None or self.roll is None or self.pitch is None:
+            return None
+        return AxisDegrees.from_raw(self.yaw, self.roll, self.pitch)
 
 
 @register

@@ -7,10 +7,7 @@ from typing import ClassVar
 
 from gimbal.messages.base import GIMBAL_CMD_SET, register
 from gimbal.messages.kinds import Command, Reply, ReturnCodeReply
-
-LIMIT_RANGES = {"pitch_max": (0, 145), "pitch_min": (0, 55), "yaw_max": (0, 179),
-                "yaw_min": (0, 179), "roll_max": (0, 30), "roll_min": (0, 30)}
-STIFFNESS_RANGES = {"pitch_stiffness": (0, 100), "roll_stiffness": (0, 100), "yaw_stiffness": (0, 100)}
+from gimbal.messages.limits import LIMIT_RANGES, STIFFNESS_RANGES
 NO_OPERATION = 0x00
 DO_OPERATION = 0x01
 _NOOP_OR_DO = {"ctrl_byte": frozenset({NO_OPERATION, DO_OPERATION})}

@@ -6,7 +6,8 @@ from typing import ClassVar
 
 from gimbal.messages.base import GIMBAL_CMD_SET, register
 from gimbal.messages.kinds import Command, DevicePush, HostPush, Reply, ReturnCodeReply
-from gimbal.messages.settings import LIMIT_RANGES, STIFFNESS_RANGES
+from gimbal.messages.limits import LIMIT_RANGES, STIFFNESS_RANGES
+from gimbal.messages.motion import AxisDegrees
 
 PUSH_NO_OPERATION = 0x00
 PUSH_ENABLE = 0x01
@@ -87,6 +88,21 @@ class ParameterPush(DevicePush):
     def joint_valid(self) -> bool:
         """``angles_valid`` and the joint angles are present too."""
         return self.angles_valid and self.pitch_joint_angle is not None
+
+    @property
+    def attitude(self) -> AxisDegrees | None:
+        """The attitude in degrees when ``angles_valid``, else None."""
+        if not self.angles_valid:
+            return None
+        return AxisDegrees.from_raw(self.yaw_angle, self.roll_angle, self.pitch_angle)  # type: ignore[arg-type]
+
+    @property
+    def joint(self) -> AxisDegrees | None:
+        """The joint angles in degrees when ``joint_valid``, else None."""
+        if not self.joint_valid:
+            return None
+        return AxisDegrees.from_raw(self.yaw_joint_angle, self.roll_joint_angle,  # type: ignore[arg-type]
+                                    self.pitch_joint_angle)
 
     @property
     def limits_valid(self) -> bool:

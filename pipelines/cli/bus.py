@@ -37,7 +37,7 @@ def open_host_bus(args: argparse.Namespace) -> Iterator[can.BusABC]:
     try:
         yield bus
     finally:
-        if not bus._is_shutdown:  # a LoggingBus around it shut it down; slcan's second shutdown raises
+        if not bus._is_shutdown:  # already shut down by its user: slcan's second shutdown raises
             bus.shutdown()
 
 

@@ -14,16 +14,19 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, MAX_TIMEOUT, ORIENTATIONS,
-                           FIRST_SEQ, GimbalClient, lookup, position_message, speed_message)
+from gimbal.client import (ANGLE_KINDS, FOCUS_CALIBRATIONS, FOLLOW_MODES, ORIENTATIONS, GimbalClient,
+                           lookup, position_message, speed_message)
 from gimbal.errors import GimbalError, GimbalTimeoutError, RangeError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
+from gimbal.matcher import FIRST_SEQ
 from gimbal.messages import Message, message_packet
 from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQuery
 from gimbal.messages.external import (FOCUS_CALIBRATION_STATES, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, JoystickPush)
-from gimbal.messages.motion import ANGLE_RANGES, AXES, GetAngles, from_raw
-from gimbal.messages.settings import (LIMIT_RANGES, ActiveTrack, GetAngleLimits, GetMotorStiffness,
+from gimbal.messages.limits import (ANGLE_RANGES, DIAL_RANGE, FOCUS_POSITION_RANGE, JOYSTICK_RANGE,
+                                    LIMIT_RANGES, MAX_SPEED_DPS, STIFFNESS_RANGES, TIME_RANGE)
+from gimbal.messages.motion import AXES, GetAngles, from_raw
+from gimbal.messages.settings import (ActiveTrack, GetAngleLimits, GetMotorStiffness,
                                       RecenterSelfie, SetAngleLimits, SetFollowMode,
                                       SetMotorStiffness, SetWorkMode, SELFIE)
 from gimbal.messages.telemetry import (PUSH_DISABLE, PUSH_ENABLE, ParameterPush, PushControl,
@@ -32,6 +35,7 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
                                         GetUserParams, SetUserParams, Tlv, autotune,
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
+from gimbal.session import MAX_TIMEOUT
 from pipelines.cli.bus import open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import (CliError, add_bus_options, hold_on_devnull, parse_int, parse_seconds,
@@ -61,8 +65,9 @@ class Command:
 
 # -- helpers ---------------------------------------------------------------------------------
 
-def _deg(raw: int | None) -> float | None:
-    return None if raw is None else from_raw(raw)
+def _span(limits: tuple[int, int], unit: Callable[[int], float] = float) -> str:
+    """A document range for help text, e.g. ``-180..180`` (``unit`` converts from wire units)."""
+    return f"{unit(limits[0]):g}..{unit(limits[1]):g}"
 
 
 def _angles(client: GimbalClient, kind: str) -> Result:
@@ -104,10 +109,10 @@ def describe_push(message: Message, t: float) -> Result:
     """A device push as readable values (angles in degrees)."""
     out: Result = {"t": round(t, 4), "push": message.NAME}
     if isinstance(message, ParameterPush):
-        if message.angles_valid:
-            out["attitude"] = {a: _deg(getattr(message, f"{a}_angle")) for a in AXES}
-        if message.joint_valid:
-            out["joint"] = {a: _deg(getattr(message, f"{a}_joint_angle")) for a in AXES}
+        if message.attitude is not None:
+            out["attitude"] = message.attitude._asdict()
+        if message.joint is not None:
+            out["joint"] = message.joint._asdict()
         if message.limits_valid:
             out["limits"] = {n: getattr(message, n) for n in LIMITS}
         if message.stiffness_valid:
@@ -151,12 +156,13 @@ def _angles_messages(args: argparse.Namespace) -> list[Message]:
 def _move_args(p: argparse.ArgumentParser) -> None:
     for axis, (low, high) in ANGLE_RANGES.items():
         p.add_argument(f"--{axis}", type=float,
-                       help=f"{axis} in degrees ({from_raw(low):g}..{from_raw(high):g}); omitted axes stay")
+                       help=f"{axis} in degrees ({_span((low, high), from_raw)}); omitted axes stay")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--absolute", dest="absolute", action="store_true", default=True,
                       help="angles are absolute (default)")
     mode.add_argument("--relative", dest="absolute", action="store_false", help="angles are offsets")
-    p.add_argument("--time", type=float, default=2.0, help="seconds to get there, 0..25.5 (default 2)")
+    p.add_argument("--time", type=float, default=2.0,
+                   help=f"seconds to get there, {_span(TIME_RANGE, from_raw)} (default 2)")
 
 
 def _move_message(args: argparse.Namespace) -> list[Message]:
@@ -177,7 +183,8 @@ def _move(client: GimbalClient, args: argparse.Namespace) -> Result:
 
 def _speed_args(p: argparse.ArgumentParser) -> None:
     for axis in ("yaw", "pitch", "roll"):
-        p.add_argument(f"--{axis}", type=float, default=0.0, help=f"{axis} speed in °/s (-360..360)")
+        p.add_argument(f"--{axis}", type=float, default=0.0,
+                       help=f"{axis} speed in °/s ({-MAX_SPEED_DPS:g}..{MAX_SPEED_DPS:g})")
     p.add_argument("--duration", type=parse_seconds, default=1.0, help="seconds to keep turning (default 1)")
     p.add_argument("--rate", type=float, default=25.0,
                    help=f"keep-alive rate in Hz, {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} (default 25)")
@@ -196,12 +203,13 @@ def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:
     finally:
         streamer.stop()
     stats = streamer.stats
-    if stats["reply_errors"] or (stats["reply_timeouts"] and not stats["replies"]):
+    if stats["reply_errors"] or (stats["reply_timeouts"] and not (stats["replies"] or stats["late_replies"])):
         failed = " and ".join(f"{what} {stats[key]}" for what, key in (("refused", "reply_errors"),
                                                                      ("did not answer", "reply_timeouts"))
                               if stats[key])
         raise CliError(f"the gimbal {failed} of {stats['sent']} speed commands", exit_code=1)
-    return {"duration_s": args.duration, **{k: stats[k] for k in ("sent", "reply_errors", "reply_timeouts")}}
+    counts = ("sent", "reply_errors", "reply_timeouts", "late_replies")
+    return {"duration_s": args.duration, **{k: stats[k] for k in counts}}
 
 
 def _limits_args(p: argparse.ArgumentParser) -> None:
@@ -238,7 +246,8 @@ def _limits(client: GimbalClient, args: argparse.Namespace) -> Result:
 
 def _stiffness_args(p: argparse.ArgumentParser) -> None:
     for axis in STIFFNESS:
-        p.add_argument(f"--{axis}", type=int, help=f"{axis} motor stiffness 0..100")
+        p.add_argument(f"--{axis}", type=int,
+                       help=f"{axis} motor stiffness {_span(STIFFNESS_RANGES[f'{axis}_stiffness'])}")
 
 
 def _stiffness_messages(args: argparse.Namespace) -> list[Message]:
@@ -372,8 +381,8 @@ def _focus_args(p: argparse.ArgumentParser) -> None:
                    help="position: absolute position push, unanswered (sub-ID 0x01); calibrate: a "
                    "calibration step (0x02); read: calibration state and position (0x15)")
     p.add_argument("value", nargs="?",
-                   help="position 0..4095, or auto|manual|set-min|set-max|stop|none (manual: set-min "
-                   "and set-max at the two ends first, then manual)")
+                   help=f"position {_span(FOCUS_POSITION_RANGE)}, or auto|manual|set-min|set-max|stop|none "
+                   "(manual: set-min and set-max at the two ends first, then manual)")
 
 
 def _focus_messages(args: argparse.Namespace) -> list[Message]:
@@ -387,7 +396,8 @@ def _focus_messages(args: argparse.Namespace) -> list[Message]:
         try:
             return [FocusPositionControl(position=int(args.value, 0))]
         except ValueError:
-            raise CliError(f"focus position must be an integer 0..4095, not {args.value!r}") from None
+            raise CliError(f"focus position must be an integer {_span(FOCUS_POSITION_RANGE)}, "
+                           f"not {args.value!r}") from None
     return [FocusCalibration(calibration_cmd=lookup(FOCUS_CALIBRATIONS, args.value,
                                                     "focus calibration command"))]
 
@@ -409,13 +419,13 @@ def _focus(client: GimbalClient, args: argparse.Namespace) -> Result:
 
 def _joystick_args(p: argparse.ArgumentParser) -> None:
     for axis in ("yaw", "pitch", "roll"):
-        p.add_argument(f"--{axis}", type=int, default=0, help=f"{axis} stick, raw -15000..15000")
+        p.add_argument(f"--{axis}", type=int, default=0, help=f"{axis} stick, raw {_span(JOYSTICK_RANGE)}")
     p.add_argument("--duration", type=parse_seconds, default=0.5,
                    help=f"seconds to hold it (sent at {STREAM_HZ:g} Hz, then centred; default 0.5)")
 
 
 def _dial_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("speed", type=int, help="dial speed, raw -2048..2048")
+    p.add_argument("speed", type=int, help=f"dial speed, raw {_span(DIAL_RANGE)}")
     p.add_argument("--duration", type=parse_seconds, default=0.5,
                    help=f"seconds to hold it (sent at {STREAM_HZ:g} Hz, then zeroed; default 0.5)")
 

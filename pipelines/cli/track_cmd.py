@@ -21,7 +21,7 @@ from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
-from pipelines.outputs.can_log import CanLogWriter, LoggingBus
+from pipelines.outputs.can_log import CanLogWriter
 from pipelines.sources import FrameSource, SourceError, open_source
 from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
 from tracker import SubjectTracker, available_trackers
@@ -172,9 +172,8 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             make_out_dir(options.out_dir)
             can_log = _can_log(options.out_dir / "can.log")
             try:
-                with LoggingBus(bus, can_log) as logged, \
-                        GimbalClient(logged, tx_id=args.tx_id, rx_id=args.rx_id,
-                                     legacy_attitude_order=args.legacy_order) as client:
+                with GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id, listeners=[can_log],
+                                  legacy_attitude_order=args.legacy_order) as client:
                     where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
                              " ".join(str(v) for v in (args.interface or "python-can's configured bus",
                                                        args.channel) if v))

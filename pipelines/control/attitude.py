@@ -14,8 +14,6 @@ from pipelines.control.direction import wrap_deg
 if TYPE_CHECKING:
     from gimbal.client import GimbalClient
 
-RAW_DEG = 0.1  # the DJI R SDK reports angles in 0.1 deg
-
 
 @dataclass(frozen=True, slots=True)
 class Attitude:
@@ -50,19 +48,15 @@ class AttitudeHistory:
             return
         self._samples.append(Attitude(wrap_deg(yaw), roll, pitch, timestamp))
 
-    def add_raw(self, timestamp: float, yaw: int, roll: int, pitch: int) -> None:
-        """Record an attitude in the protocol's raw 0.1 deg units."""
-        self.add(timestamp, yaw * RAW_DEG, roll * RAW_DEG, pitch * RAW_DEG)
-
     def on_push(self, msg: ParameterPush, t: float) -> None:
         """Callback for ``GimbalClient.on_push(ParameterPush, ...)``.
 
         Skips pushes whose angle-valid flag is clear or that stop short of the attitude (short
         pushes carrying the attitude but not the joint angles are used).
         """
-        if not msg.angles_valid:
-            return
-        self.add_raw(t, msg.yaw_angle, msg.roll_angle, msg.pitch_angle)
+        attitude = msg.attitude
+        if attitude is not None:
+            self.add(t, attitude.yaw, attitude.roll, attitude.pitch)
 
     def attach(self, client: GimbalClient) -> Callable[[], None]:
         """Record every ``ParameterPush`` ``client`` receives and enable the push; returns the

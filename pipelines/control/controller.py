@@ -9,7 +9,7 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Protocol
 
-from gimbal.client import DEFAULT_MAX_AGE_S
+from gimbal.keepalive import DEFAULT_MAX_AGE_S
 from pipelines.control.camera import CameraModel
 from pipelines.control.direction import Direction, DirectionFilter, PredictionTrust, compose, wrap_deg
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate

@@ -3,9 +3,10 @@ from __future__ import annotations
 
 import math
 
+from gimbal.messages.limits import MAX_SPEED_DPS as PROTOCOL_MAX_SPEED_DPS
 from pipelines.control.pid import clamp
 
-PROTOCOL_MAX_SPEED_DPS = 360.0  # the DJI R SDK speed command range
+__all__ = ["PROTOCOL_MAX_SPEED_DPS", "limit_rate"]
 
 
 def limit_rate(previous: float, wanted: float, max_speed: float, max_accel: float, dt: float) -> float:

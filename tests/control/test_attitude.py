@@ -7,8 +7,8 @@ from pipelines.control.attitude import AttitudeHistory
 def test_raw_units_and_interpolation():
     h = AttitudeHistory()
     assert h.at(1.0) is None
-    h.add_raw(1.0, 100, -20, 50)  # 10.0, -2.0, 5.0 deg
-    h.add_raw(2.0, 300, 0, -50)
+    h.on_push(ParameterPush(ctrl_byte=1, yaw_angle=100, roll_angle=-20, pitch_angle=50), 1.0)  # 10.0, -2.0, 5.0 deg
+    h.on_push(ParameterPush(ctrl_byte=1, yaw_angle=300, roll_angle=0, pitch_angle=-50), 2.0)
     a = h.at(1.25)
     assert (a.yaw, a.roll, a.pitch) == pytest.approx((15.0, -1.5, 2.5))
     assert h.at(0.0).yaw == pytest.approx(10.0)  # before the first sample: the first

@@ -12,7 +12,8 @@ from typing import Any
 import can
 import pytest
 
-from gimbal.client import ECHO_EVIDENCE, Angles, GimbalClient
+from gimbal.client import Angles, GimbalClient
+from gimbal.matcher import ECHO_EVIDENCE
 from gimbal.errors import BusError, GimbalError, GimbalTimeoutError, RangeError, ReturnCodeError
 from gimbal.messages import Message
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
@@ -465,7 +466,7 @@ def test_a_seq_matched_by_chance_does_not_make_the_client_deaf(channel: str, pee
     match made every later reply stale for good. Now it costs the next request two attempts."""
     peer.answer(VersionQuery, VersionReply(0, 1, 7), seq=0x2000)
     with GimbalClient(interface="virtual", channel=channel, timeout=0.2, retries=2) as gimbal:
-        gimbal._seq = 0x2000 - 2  # the counter about to pass the gimbal's fixed SEQ
+        gimbal.replies.next_seq = 0x2000 - 2  # the counter about to pass the gimbal's fixed SEQ
         assert all(gimbal.version().version == 7 for _ in range(8))
         assert gimbal.stats["stale_replies"] == ECHO_EVIDENCE - 1
 
@@ -474,12 +475,12 @@ def test_a_gimbal_that_stops_echoing_is_paired_by_command_again(client: GimbalCl
                                                                  peer: ScriptedPeer) -> None:
     peer.answer(VersionQuery, VersionReply(0, 1, 7))
     client.version()
-    assert client._seq_echoed
+    assert client.replies.seq_echoed
     peer.answer(VersionQuery, VersionReply(0, 1, 7), seq=0x0001)  # e.g. a firmware update
     with pytest.raises(GimbalTimeoutError):  # both attempts' replies taken for late ones
         client.version()
     assert client.version().version == 7  # the third in a row: paired by command from here on
-    assert not client._seq_echoed and client.stats["stale_replies"] == ECHO_EVIDENCE - 1
+    assert not client.replies.seq_echoed and client.stats["stale_replies"] == ECHO_EVIDENCE - 1
 
 
 def test_close_from_another_thread_leaves_the_stop_as_the_last_speed_command(

@@ -1,6 +1,8 @@
-"""CAN log: both directions recorded by LoggingBus, flushed per frame, read back by can.LogReader."""
+"""CAN log: both directions recorded by a CanLogWriter on the client's Notifier (received) and at
+send (ours), flushed per frame, read back by can.LogReader."""
 from __future__ import annotations
 
+import time
 import uuid
 from collections.abc import Callable
 from pathlib import Path
@@ -8,7 +10,9 @@ from pathlib import Path
 import can
 import pytest
 
-from pipelines.outputs.can_log import CanLogWriter, LoggingBus
+from gimbal.client import GimbalClient
+from pipelines.outputs.can_log import CanLogWriter
+from tests.gimbal.scripted_peer import poll
 
 
 @pytest.fixture
@@ -23,14 +27,14 @@ def _message(arbitration_id: int, data: bytes) -> can.Message:
 def test_sent_and_received_frames_are_logged_with_their_direction(tmp_path: Path, channel: str) -> None:
     path = tmp_path / "can.log"
     peer = can.Bus(interface="virtual", channel=channel)
-    bus = LoggingBus(can.Bus(interface="virtual", channel=channel), CanLogWriter(path))
+    bus = can.Bus(interface="virtual", channel=channel)
     try:
-        bus.send(_message(0x223, bytes([0xAA, 0x1A, 0x00])))
-        assert peer.recv(5.0) is not None
-        peer.send(_message(0x222, bytes([0xAA, 0x0E])))
-        received = bus.recv(5.0)
-        assert received is not None and received.arbitration_id == 0x222
-        bus.send(_message(0x223, b"\x01\x02"))
+        with GimbalClient(bus, listeners=[CanLogWriter(path)]) as client:
+            client.transport.send(bytes([0xAA, 0x1A, 0x00]))
+            assert peer.recv(5.0) is not None
+            peer.send(_message(0x222, bytes([0xAA, 0x0E])))
+            poll(lambda: len(list(can.LogReader(path))) == 2)
+            client.transport.send(b"\x01\x02")
     finally:
         bus.shutdown()
         peer.shutdown()
@@ -40,16 +44,15 @@ def test_sent_and_received_frames_are_logged_with_their_direction(tmp_path: Path
     assert stamps == sorted(stamps) and stamps[0] > 0
 
 
-def test_proxy_filters_apply_after_logging(tmp_path: Path, channel: str) -> None:
+def test_the_log_holds_all_traffic_read_not_only_the_gimbals(tmp_path: Path, channel: str) -> None:
     path = tmp_path / "can.log"
     peer = can.Bus(interface="virtual", channel=channel)
-    bus = LoggingBus(can.Bus(interface="virtual", channel=channel), CanLogWriter(path),
-                     can_filters=[{"can_id": 0x222, "can_mask": 0x7FF}])
+    bus = can.Bus(interface="virtual", channel=channel)
     try:
-        peer.send(_message(0x100, b"\x00"))
-        peer.send(_message(0x222, b"\x01"))
-        received = bus.recv(5.0)
-        assert received is not None and received.arbitration_id == 0x222
+        with GimbalClient(bus, listeners=[CanLogWriter(path)]):
+            peer.send(_message(0x100, b"\x00"))
+            peer.send(_message(0x222, b"\x01"))
+            poll(lambda: len(list(can.LogReader(path))) == 2)
     finally:
         bus.shutdown()
         peer.shutdown()
@@ -81,20 +84,20 @@ def test_writer_ignores_messages_after_stop(tmp_path: Path) -> None:
     assert path.read_text().split()[1:] == ["can1", "222#01", "R"]
 
 
-def test_a_bus_that_echoes_our_frames_logs_and_returns_each_frame_once(tmp_path):
-    """python-can's udp_multicast hands a sender its own frames back; a virtual bus with
-    receive_own_messages=True does the same, in-process."""
+def test_a_bus_that_returns_our_frames_logs_each_frame_once(tmp_path: Path) -> None:
+    """A bus opened with receive_own_messages=True hands our frames back marked is_rx=False
+    (python-can's convention): those are what the log holds, not a second copy made at send."""
     channel = f"echo-{uuid.uuid4().hex}"
     path = tmp_path / "echo.log"
     echoing = can.Bus(interface="virtual", channel=channel, receive_own_messages=True)
     peer = can.Bus(interface="virtual", channel=channel)
-    with LoggingBus(echoing, CanLogWriter(path)) as bus:
+    with GimbalClient(echoing, listeners=[CanLogWriter(path)]) as client:
         for i in range(3):
-            bus.send(can.Message(arbitration_id=0x223, is_extended_id=False, data=[i, 1, 2]))
+            client.transport.send(bytes([i, 1, 2]))
         peer.send(can.Message(arbitration_id=0x222, is_extended_id=False, data=[9, 9]))
-        received = bus.recv(0.5)
-        assert received is not None and received.arbitration_id == 0x222
-        assert bus.recv(0.05) is None  # the three echoes were swallowed
+        poll(lambda: len(list(can.LogReader(path))) == 4)
+        time.sleep(0.05)  # nothing more comes
+    echoing.shutdown()
     peer.shutdown()
     logged = list(can.LogReader(path))
     assert [(m.arbitration_id, m.is_rx) for m in logged] == [(0x223, False)] * 3 + [(0x222, True)]
@@ -108,11 +111,12 @@ def test_a_failed_write_never_stops_the_frames(tmp_path: Path, channel: str) -> 
     path.symlink_to("/dev/full")
     log = CanLogWriter(path)
     peer = can.Bus(interface="virtual", channel=channel)
-    bus = LoggingBus(can.Bus(interface="virtual", channel=channel), log)
+    bus = can.Bus(interface="virtual", channel=channel)
     try:
-        for i in range(3):
-            bus.send(_message(0x223, bytes([i])))
-        assert [bytes(peer.recv(5.0).data) for _ in range(3)] == [b"\x00", b"\x01", b"\x02"]
+        with GimbalClient(bus, listeners=[log]) as client:
+            for i in range(3):
+                client.transport.send(bytes([i]))
+            assert [bytes(peer.recv(5.0).data) for _ in range(3)] == [b"\x00", b"\x01", b"\x02"]
     finally:
         bus.shutdown()
         peer.shutdown()

@@ -102,7 +102,7 @@ class SpeedCommand:
 
 
 def decoded(can_log: Path) -> list[dict[str, Any]]:
-    """Every packet in the log as recorded; LoggingBus leaves out the bus's echo of its own frames
+    """Every packet in the log as recorded; the client leaves out the bus's echo of its own frames
     (udp_multicast loops every sent frame back to the sender), so no host frame is marked ``R``."""
     frames = list(can.LogReader(str(can_log)))
     assert not any(f.arbitration_id == HOST_TX_ID and f.is_rx for f in frames), "echo of a host frame logged"

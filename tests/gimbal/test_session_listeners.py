@@ -1,0 +1,81 @@
+"""The client's can.Notifier is shared: any python-can listener sees the bus's traffic and ours."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import can
+import pytest
+
+from gimbal.client import GimbalClient
+from gimbal.errors import BusError
+from gimbal.messages import message_packet
+from gimbal.messages.motion import AnglesReply, GetAngles
+from gimbal.messages.telemetry import ParameterPush
+from gimbal.packet import encode_packet
+from gimbal.session import _Taps
+from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport, packet_frames
+from tests.gimbal.scripted_peer import ScriptedPeer
+
+
+def _drain(reader: can.BufferedReader) -> list[can.Message]:
+    frames = []
+    while (frame := reader.get_message(0.0)) is not None:
+        frames.append(frame)
+    return frames
+
+
+def test_a_listener_added_later_gets_what_the_bus_saw_in_both_directions(channel: str,
+                                                                           peer: ScriptedPeer) -> None:
+    peer.answer(GetAngles, AnglesReply(0, 1, 10, 20, 30))
+    reader = can.BufferedReader()
+    with GimbalClient(interface="virtual", channel=channel) as client:
+        client.add_listener(reader)
+        client.get_angles()  # the taps come before the matcher: the whole reply is in the reader
+    frames = _drain(reader)
+    sent = [bytes(f.data) for f in frames if f.arbitration_id == HOST_TX_ID]
+    received = [bytes(f.data) for f in frames if f.arbitration_id == HOST_RX_ID]
+    assert all(not f.is_rx for f in frames if f.arbitration_id == HOST_TX_ID)
+    assert all(f.is_rx for f in frames if f.arbitration_id == HOST_RX_ID)
+    assert b"".join(sent) == encode_packet(peer.received[0].packet)
+    assert b"".join(received) == encode_packet(message_packet(AnglesReply(0, 1, 10, 20, 30),
+                                                              peer.received[0].packet.seq))
+
+
+def test_a_bus_with_a_notifier_of_its_own_is_refused_in_one_line(channel: str) -> None:
+    bus = can.Bus(interface="virtual", channel=channel)
+    notifier = can.Notifier(bus, [])
+    try:
+        with pytest.raises(BusError, match="cannot receive on the CAN bus"):
+            GimbalClient(bus)
+    finally:
+        notifier.stop()
+        bus.shutdown()
+
+
+def test_closing_lets_the_taps_finish_the_packet_in_progress_and_no_more(channel: str) -> None:
+    bus = can.Bus(interface="virtual", channel=channel)
+    reader = can.BufferedReader()
+    taps = _Taps(CanTransport(bus))
+    taps.listeners.append(reader)
+    push = packet_frames(encode_packet(message_packet(ParameterPush(0x01, 1, 2, 3), 7)), HOST_RX_ID)
+    assert len(push) > 2
+    try:
+        taps.on_message_received(push[0])
+        taps.close_at_packet_end()
+        for frame in push[1:]:
+            taps.on_message_received(frame)
+        taps.on_message_received(push[0])  # the next packet: nobody reads it to its end
+        taps.on_message_received(can.Message(arbitration_id=0x100, is_extended_id=False, data=b"\x01"))
+    finally:
+        bus.shutdown()
+    assert [bytes(f.data) for f in _drain(reader)] == [bytes(f.data) for f in push]
+
+
+def test_python_cans_own_logger_records_both_directions(channel: str, peer: ScriptedPeer, tmp_path: Path) -> None:
+    """Any python-can log format works as a tap: here ``.asc``, whose lines say Tx or Rx."""
+    peer.answer(GetAngles, AnglesReply(0, 1, 10, 20, 30))
+    path = tmp_path / "session.asc"
+    with GimbalClient(interface="virtual", channel=channel, listeners=[can.Logger(path)]) as client:
+        client.get_angles()
+    directions = {(m.arbitration_id, m.is_rx) for m in can.LogReader(path)}
+    assert directions == {(HOST_TX_ID, False), (HOST_RX_ID, True)}
