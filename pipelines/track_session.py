@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import queue
 import time
 from collections import Counter
 from collections.abc import Callable
@@ -20,7 +21,10 @@ from gimbal.errors import GimbalError
 from gimbal.messages import ParameterPush
 from gimbal.signals import deferred_signals
 from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
+from gimbal.keepalive import SpeedStreamer
 from pipelines.control import AttitudeHistory, CameraModel, ControlConfig, make_controller
+from pipelines.control.controller import RateCommand
+from pipelines.control.tuning import settings_of
 from pipelines.outputs.annotated_video import BackgroundVideoWriter, rates_text
 from pipelines.outputs.can_log import CanLogWriter
 from pipelines.outputs.latency import latency_percentiles
@@ -68,6 +72,18 @@ class TrackOptions:
     video: bool = True
     video_width: int | None = DEFAULT_VIDEO_WIDTH  # None: the source's own size
     progress: bool = True
+
+
+@dataclass(frozen=True)
+class SessionRecord:
+    """One frame as the session's extra sinks (the console) get it."""
+
+    index: int
+    t: float
+    state: str
+    estimate: TargetEstimate | None
+    command: RateCommand
+    candidates: tuple[tuple[float, ...], ...]
 
 
 @dataclass
@@ -145,6 +161,14 @@ class TrackSession:
         self._started = time.monotonic()
         self._last_summary = 0.0
         self._streamer = None
+        self._stopped_streamers: list[SpeedStreamer] = []  # paused ones: their counts stay in the summary
+        # an operator's hands (the console): work run on this thread at the start of a step
+        self._work: queue.SimpleQueue[tuple[Callable[[], Any], dict[str, Any] | None]] = queue.SimpleQueue()
+        self.paused = False
+        self.stop_reason: str | None = None
+        self.candidates: tuple[tuple[float, ...], ...] = ()  # the detector's boxes of the last frame
+        self._selected: tuple[float, ...] | None = None
+        self.sinks: list[Any] = []  # more outputs, each ``on_frame(record, frame)`` after the telemetry
         self._progress = ProgressReporter(source.frame_count, enabled=options.progress)
         out = options.out_dir
         self.paths = {"telemetry": out / "telemetry.jsonl", "can_log": out / "can.log",
@@ -170,6 +194,9 @@ class TrackSession:
         for frame in self.source:
             with deferred_signals():  # a frame's telemetry, video and counts are written whole
                 self.step(frame)
+            if self.stop_reason is not None:
+                self.reason = self.stop_reason
+                return
             if self.options.max_frames is not None and self.frames >= self.options.max_frames:
                 self.reason = "max frames reached"
                 return
@@ -177,18 +204,22 @@ class TrackSession:
 
     def step(self, frame: Frame) -> None:
         """One frame: track, control, stream the setpoint, write the outputs."""
+        notes = self._run_submitted()
         stamp = frame.timestamp if self._monotonic_stamps else time.monotonic()
         estimate = self._track(frame, stamp)
-        attitude = self._attitude_at(stamp)
-        command = self.controller.update(estimate, attitude, time.monotonic())
-        self._streamer.set(command.yaw_dps * self.options.yaw_sign,
-                           command.pitch_dps * self.options.pitch_sign, stamp=stamp)
+        if self.paused:  # the gimbal holds: the keep-alive is stopped, nothing is sent
+            command = RateCommand(0.0, 0.0, stamp=stamp, mode="paused")
+        else:
+            attitude = self._attitude_at(stamp)
+            command = self.controller.update(estimate, attitude, time.monotonic())
+            self._streamer.set(command.yaw_dps * self.options.yaw_sign,
+                               command.pitch_dps * self.options.pitch_sign, stamp=stamp)
         if estimate is not None and estimate.found and self.first_acquired_s is None:
             self.first_acquired_s = time.monotonic() - self._started
             if self.options.record:
                 self._start_recording()
-        state = estimate.state.value if estimate is not None else "acquiring"
-        self._write_frame(frame, stamp, state, estimate, command)
+        state = "paused" if self.paused else estimate.state.value if estimate is not None else "acquiring"
+        self._write_frame(frame, stamp, state, estimate, command, notes)
         if self.can_log is not None and self.can_log.error is not None:
             raise OSError(f"cannot write the CAN log {self.can_log.path}: {self.can_log.error}")
         self._progress.update(self.frames, lambda: f"{state:<9} yaw {command.yaw_dps:+6.1f} "
@@ -200,6 +231,11 @@ class TrackSession:
         """None until the subject is chosen; then the tracker's estimate. A lost subject is found
         again by the tracker: a detection that looks like it (``SubjectTracker``), never merely the
         nearest one, so the subject's look is kept and another person's is not taken for it."""
+        if self._selected is not None:  # an operator's choice
+            box, self._selected = self._selected, None
+            self._estimate = self.tracker.init(frame.image, box, stamp)
+            return self._estimate
+        self.candidates = ()
         if self._estimate is None:
             box = self.options.roi if self.options.roi is not None else self._detect(frame)
             if box is None:
@@ -214,7 +250,9 @@ class TrackSession:
         (the motion detector needs consecutive frames)."""
         if self.detector is None:
             return None
-        confirmed = self._confirmer.offer(self.detector.detect(frame.image), self.source.size)
+        detections = self.detector.detect(frame.image)
+        self.candidates = tuple(tuple(d.box) for d in detections)
+        confirmed = self._confirmer.offer(detections, self.source.size)
         found = pick_candidate(confirmed, self.source.size, self.options.pick)
         return None if found is None else tuple(found.box)
 
@@ -229,7 +267,7 @@ class TrackSession:
         return signed_attitude(sample.yaw, sample.pitch, self.options)
 
     def _write_frame(self, frame: Frame, stamp: float, state: str, estimate: TargetEstimate | None,
-                     command: Any) -> None:
+                     command: Any, notes: tuple[dict[str, Any], ...] = ()) -> None:
         """Telemetry first, then the frame is counted (summary and plot), then the video: the
         summary's ``frames`` are the telemetry's lines, whichever output fails."""
         attitude = self.history.latest()
@@ -246,6 +284,9 @@ class TrackSession:
                        [attitude.yaw, attitude.pitch, attitude.roll],
                        "attitude_t": None if attitude is None else attitude.timestamp,
                        "dropped": self.source.dropped})
+        record["state"] = state  # paused, whatever the tracker says
+        if notes:
+            record["operator"] = list(notes)
         self.telemetry.write(record)
         self.frames += 1
         self.states[state] += 1
@@ -260,6 +301,8 @@ class TrackSession:
             s.error_count += 1
             s.error_sum += error
             s.error_max = error if s.error_max is None else max(s.error_max, error)
+        for sink in self.sinks:
+            sink.on_frame(SessionRecord(frame.index, stamp, state, estimate, command, self.candidates), frame)
         if self.video is not None:  # labelled with the source's frame index and the recording's time
             shown_t = record.get("t_video", record["t_run"])
             shown = None if estimate is None else dataclasses.replace(estimate, frame_index=frame.index,
@@ -271,6 +314,80 @@ class TrackSession:
                 self.video.write(frame.image, None, None, [f"#{frame.index} t={shown_t:.3f}s acquiring",
                                                            rates_text(rates), f"mode {command.mode}"])
 
+    # -- an operator's actions (the console): through ``submit``, run on this thread ---------
+    def submit(self, fn: Callable[[], Any], note: dict[str, Any] | None = None) -> None:
+        """Run ``fn`` at the start of the next step; safe from any thread. ``note`` goes into that
+        frame's telemetry (``operator``), with the ``error`` if ``fn`` raised."""
+        self._work.put((fn, note))
+
+    def _run_submitted(self) -> tuple[dict[str, Any], ...]:
+        notes = []
+        while True:
+            try:
+                fn, note = self._work.get_nowait()
+            except queue.Empty:
+                return tuple(notes)
+            try:
+                fn()
+            except (GimbalError, ValueError, RuntimeError) as exc:
+                note = None if note is None else {**note, "error": str(exc)}
+            if note is not None:
+                notes.append(note)
+
+    def start_tracking(self, box: tuple[float, ...]) -> None:
+        self._selected = tuple(box)
+
+    def start_recording(self) -> None:
+        if not self.recording.get("started") or self.recording.get("stopped"):
+            self.recording.pop("stopped", None)
+            self.recording.pop("stop_confirmed", None)
+            self._start_recording()
+
+    def stop_recording(self) -> None:
+        if self.recording.get("started") and not self.recording.get("stopped"):
+            self._camera_action(self.client.stop_recording, "stopped", "stop_confirmed", recording=False)
+
+    @property
+    def recording_on(self) -> bool:
+        return bool(self.recording.get("started")) and not self.recording.get("stopped")
+
+    def stop(self, reason: str) -> None:
+        self.stop_reason = reason
+
+    def pause(self) -> None:
+        """Zero speed, then release (the keep-alive's stop); frames go on being tracked."""
+        if not self.paused:
+            self.paused = True
+            self._streamer.stop()
+            self._stopped_streamers.append(self._streamer)
+
+    def resume(self) -> None:
+        if self.paused:
+            self.controller.reset()
+            self._streamer = self.client.speed_streamer(rate_hz=self.options.rate_hz)
+            self.paused = False
+
+    def recenter(self) -> None:
+        self.pause()
+        self.client.recenter()
+
+    def retune(self, config: ControlConfig) -> None:
+        self.controller.retune(config)
+
+    def streamers(self) -> list[SpeedStreamer]:
+        """Every keep-alive of the run: those ``pause`` stopped, then the current one."""
+        current = self._streamer is not None and all(s is not self._streamer for s in self._stopped_streamers)
+        return [*self._stopped_streamers, self._streamer] if current else list(self._stopped_streamers)
+
+    def latencies(self) -> list[float]:
+        return [latency for streamer in self.streamers() for latency in streamer.latencies()]
+
+    def speed_stats(self) -> dict[str, int]:
+        summed: Counter[str] = Counter()
+        for streamer in self.streamers():
+            summed.update(streamer.stats)
+        return dict(summed)
+
     # -- recording -----------------------------------------------------------------------
     def _start_recording(self) -> None:
         self._camera_action(self.client.start_recording, "started", "start_confirmed", recording=True)
@@ -279,7 +396,7 @@ class TrackSession:
         if self.recording["requested"] and self.first_acquired_s is None:
             self.recording["started"] = False
             self.recording["error"] = "the subject was never acquired"
-        if not self.recording.get("started"):
+        if not self.recording_on:  # never started, or an operator stopped it already
             return
         self._camera_action(self.client.stop_recording, "stopped", "stop_confirmed", recording=False)
 
@@ -312,7 +429,7 @@ class TrackSession:
         self.error = error or self.error
         if self._streamer is not None:
             try:
-                self._streamer.stop()
+                self._streamer.stop()  # nothing new when paused: that stop was sent
             except (GimbalError, OSError) as exc:
                 log.warning("could not send the stop command: %s", exc)
         try:
@@ -362,8 +479,7 @@ class TrackSession:
     def _summary(self) -> dict[str, Any]:
         """The summary as it stands."""
         elapsed = time.monotonic() - self._started
-        streamer = self._streamer
-        latencies = streamer.latencies() if streamer is not None else []
+        latencies = self.latencies()
         s = self.series
         return {
             "status": self.reason, "error": self.error,
@@ -378,8 +494,9 @@ class TrackSession:
                                   "max": s.error_max, "frames": s.error_count},
             "latency_ms": {k: (v * 1000.0 if isinstance(v, float) else v)
                            for k, v in latency_percentiles(latencies).items()},
-            "speed_commands": {**(streamer.stats if streamer is not None else {}),
+            "speed_commands": {**self.speed_stats(),
                                **{k: v for k, v in self.client.stats.items() if k.startswith("stop_")}},
             "recording": self.recording,
+            "settings": settings_of(self.controller.config),
             "outputs": {k: str(v) for k, v in self.paths.items()},
         }

@@ -33,7 +33,6 @@ from pipelines.console.security import Guard
 from pipelines.console.sink import ConsoleSink, Snapshot
 from pipelines.outputs._files import to_plain
 
-
 MAX_VIEWERS = 4
 MAX_EVENT_STREAMS = 8
 DEFAULT_FPS = 15.0

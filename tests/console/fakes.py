@@ -72,6 +72,7 @@ class FrameFeeder:
                  noisy: bool = False) -> None:
         self.sink, self.fps, self.work_s = sink, fps, work_s
         self.frames = 0
+        self.hand_over_s: list[float] = []  # each on_frame call's duration
         self.error: BaseException | None = None
         self._stop = threading.Event()
         self._images = [synthetic_image(i, noisy) for i in range(IMAGES)]
@@ -96,13 +97,15 @@ class FrameFeeder:
                     while time.perf_counter() < end:
                         pass
                 index = self.frames
+                handed = time.perf_counter()
                 self.sink.on_frame(view(index, time.monotonic()), self._images[index % len(self._images)])
+                self.hand_over_s.append(time.perf_counter() - handed)
                 self.frames += 1
                 self.ended = time.monotonic()
                 if self.fps:
                     next_t += 1.0 / self.fps
                     self._stop.wait(max(0.0, next_t - time.monotonic()))
-        except BaseException as exc:
+        except BaseException as exc:  # noqa: BLE001 (the test reads it)
             self.error = exc
 
     def rate(self) -> float:

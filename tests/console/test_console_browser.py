@@ -70,7 +70,7 @@ def test_watch_pick_record_and_pause_from_the_browser(tmp_path: Path) -> None:
     assert line["state"] == "tracking" and all(abs(a - b) <= 3 for a, b in zip(line["box"], select["box"]))
     records = decoded(run.out / "can.log")
     sent = host_commands(records)
-    assert [r["fields"]["action"] for r in sent if r["name"] == "camera_action"][0] == CameraActionCode.START_RECORDING
+    assert next(r["fields"]["action"] for r in sent if r["name"] == "camera_action") == CameraActionCode.START_RECORDING
     speeds = speed_commands(records)
     release = next(i for i, s in enumerate(speeds) if s.ctrl == SPEED_RELEASE)  # the pause's
     assert speeds[release].zero and speeds[release - 1].zero

@@ -14,7 +14,12 @@ from tests.console.http_helpers import post, request
 from tests.console.track_run import FRAMES, ConsoleRun, drifting_slowly, subject_box
 from tests.support import wait_until
 from tests.track.helpers import (
-    assert_stopped_at_end, decoded, host_commands, make_clip, run_track, speed_commands,
+    assert_stopped_at_end,
+    decoded,
+    host_commands,
+    make_clip,
+    run_track,
+    speed_commands,
 )
 
 

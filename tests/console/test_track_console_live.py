@@ -10,8 +10,21 @@ from pathlib import Path
 from gimbal.client import SPEED_RELEASE
 from tests.console.http_helpers import post, request
 from tests.console.track_run import ConsoleRun
-from tests.support import ROOT, cli_command, free_udp_port, require_ffmpeg, subprocess_env, wait_until
-from tests.track.helpers import DEMO, assert_stopped_at_end, decoded, speed_commands, start
+from tests.support import (
+    ROOT,
+    cli_command,
+    free_udp_port,
+    require_ffmpeg,
+    subprocess_env,
+    wait_until,
+)
+from tests.track.helpers import (
+    DEMO,
+    assert_stopped_at_end,
+    decoded,
+    speed_commands,
+    start,
+)
 
 GROUP = "239.74.163.9"
 
