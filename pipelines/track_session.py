@@ -19,6 +19,7 @@ from gimbal.watchdog import DEFAULT_TIMEOUT_S
 from pipelines.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartConfirmer
 from pipelines.control import CameraModel, ControlConfig, make_controller
 from pipelines.control.gimbal_link import GimbalLink, Signs
+from pipelines.control.tuning import settings_of
 from pipelines.loop import Loop, PlotSink, ProgressSink, Recorder, SummarySink, TelemetrySink, VideoSink
 from pipelines.loop.link import LinkNotices, LinkSink, link_health
 from pipelines.loop.record import FrameRecord
@@ -259,5 +260,6 @@ class TrackSession:
             "speed_commands": dict(self.link.stats()),
             "bus_health": link_health(self.link.health(), self.link.other_hosts()),
             "recording": self.recorder.status,
+            "settings": settings_of(self.loop.controller.config),
             "outputs": {k: str(v) for k, v in self.paths.items()},
         }

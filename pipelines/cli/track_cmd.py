@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import socket
 import sys
 import time
-from contextlib import ExitStack
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -114,6 +116,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--video-width", type=int, default=DEFAULT_VIDEO_WIDTH, metavar="PX",
                      help=f"shrink the annotated video to at most this width (default: {DEFAULT_VIDEO_WIDTH}, "
                      "cheap to encode; 0: the source's full size)")
+    run.add_argument("--console", metavar="[HOST:]PORT",
+                     help="serve the operator console (live view, status, pick the subject, pause, record, "
+                     "stop) on this port, on 127.0.0.1 unless a host is given (any other host needs a token; "
+                     "the URL is printed on stderr at start)")
+    run.add_argument("--console-token", metavar="TOKEN",
+                     help="the console's token (default: one is generated when the host is not loopback)")
     run.add_argument("--quiet", action="store_true", help="no progress line, and no line naming the bus "
                      "chosen without -i (the summary names it)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -203,7 +211,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
         where, chosen = choose_track_bus(args)
         if args.sim_faults is not None and args.interface != SIM_INTERFACE:
             raise CliError("--sim-faults is for the built-in simulated gimbal (-i sim)")
-        with open_host_bus(args) as bus, ExitStack() as held:
+        with _console_socket(args) as console, open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
             pending_signals = held.enter_context(deferred_signals())
@@ -221,7 +229,11 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                         raise
                     if chosen and not args.quiet:  # once the gimbal answered: an error before names the bus
                         print(chosen, file=sys.stderr, flush=True)
-                    return _run(session, args)
+                    if console is None:
+                        return _run(session, args)
+                    from pipelines.console.track import serving
+                    with serving(session, *console, args.console_token):
+                        return _run(session, args)
             finally:
                 can_log.stop()
 
@@ -234,6 +246,34 @@ def _refuse_a_second_controller(client: GimbalClient, where: str) -> None:
         raise CliError(f"another host is driving the gimbal on {where}: it sent "
                        f"{client.other_hosts.seen().describe()} on 0x{client.transport.tx_id:03X}; "
                        "stop it first, or pass --shared-bus to run anyway", exit_code=EXIT_OTHER_CONTROLLER)
+
+
+@contextmanager
+def _console_socket(args: argparse.Namespace) -> Iterator[tuple[Any, socket.socket] | None]:
+    """The console's address and its listening socket, bound before anything is created (a port
+    in use is bad input); None without ``--console``."""
+    if args.console is None:
+        if args.console_token is not None:
+            raise CliError("--console-token needs --console")
+        yield None
+        return
+    try:
+        from pipelines.console.address import bind, parse_console_address
+    except ImportError as exc:
+        raise CliError(f"--console needs aiohttp ({exc}): pip install 'gimbaltrack[console]'") from None
+    try:
+        address = parse_console_address(args.console)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    if args.console_token is not None and len(args.console_token) < 8:
+        raise CliError("--console-token must be at least 8 characters")
+    try:
+        sock = bind(address)
+    except OSError as exc:
+        raise CliError(f"cannot serve the console on {address.host}:{address.port}: "
+                       f"{exc.strerror or exc}") from None
+    with sock:
+        yield address, sock
 
 
 def _say_waiting(description: str) -> None:
