@@ -4,6 +4,7 @@ a clean bus, says how the link was (exit 3 when degraded, 0 when only slow), and
 still within 0.6 s of every disengagement and of the end."""
 from __future__ import annotations
 
+import itertools
 import json
 import threading
 import time
@@ -105,7 +106,8 @@ def test_the_run_rides_out_a_flaky_bus(tmp_path: Path, monkeypatch: pytest.Monke
     states = [(line["t"], line["bus"]["state"]) for line in telemetry]
     for i, (t, state) in enumerate(states):
         if state == "disengaged" and (i == 0 or states[i - 1][1] != "disengaged"):
-            back = next((u for u, s in states[i:] if s != "disengaged"), run["ended"])
+            stretch = [u for u, _ in itertools.takewhile(lambda ts: ts[1] == "disengaged", states[i:])]
+            back = stretch[-1]  # the last frame that saw it disengaged (taken back any time after)
             assert not run["watch"].moving_between(t + STOPPED_WITHIN_S, back)
             assert "stopped and released" in err.err and "taken back" in err.err
     records = run["records"]
