@@ -27,6 +27,7 @@ SUBCOMMAND_MODULES = [
     "pipelines.cli.gimbal_cmd",
     "pipelines.cli.simulate_cmd",
     "pipelines.cli.config_cmd",
+    "pipelines.cli.doctor_cmd",
 ]
 
 
