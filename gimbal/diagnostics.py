@@ -32,7 +32,7 @@ from gimbal.transport import DEFAULT_BITRATE, HOST_RX_ID, HOST_TX_ID
 
 LISTEN_S = 1.0  # the passive census at the start
 LATENCY_QUERIES = 50
-QUERY_TIMEOUT_S = 0.25  # one attitude query's wait; longer than the client's 0.1 s to measure slow replies
+QUERY_TIMEOUT_S = 0.4  # one attitude query's wait; longer than the client's 0.1 s to measure slow replies
 LATENCY_BUDGET_S = 4.0  # the latency check ends after this even if queries remain
 GIVE_UP_AFTER = 3  # unanswered queries in a row with none answered at all: nobody is there
 SLOW_P99_MS = 100.0  # the client's reply timeout: slower replies cost a retry in track
@@ -187,7 +187,7 @@ class Doctor:
         for step in (self.layout, self.latency, self.push_rate, self.camera, self.integrity):
             if step is self.camera and not self.rig.camera:
                 continue
-            yield step() if self.answering else Check(step.__name__.replace("_", " "), False,
+            yield step() if self.answering else Check(step.__name__.split("_")[0], False,
                                                        "skipped: the gimbal does not answer")
         if wiggle:
             yield from (self.wiggle() if self.answering else
@@ -263,18 +263,20 @@ class Doctor:
             summary = f"{len(times_ms)} of {sent} attitude queries answered, p50 {p50:.1f} ms, p99 {p99:.1f} ms"
         else:
             summary, p99 = f"none of {sent} attitude queries answered", 0.0
+        hints = []
         if refused:
-            return Check("latency", False, f"{summary}; {refused} refused",
-                         "the gimbal refuses commands: motors off, calibrating, or in a mode that ignores the "
-                         "R SDK (another controller in charge?)", data)
-        if lost:
-            return Check("latency", False, f"{summary}; {lost} unanswered within {QUERY_TIMEOUT_S * 1000:.0f} ms",
-                         "frames are lost: termination (120 Ω), a loose CANH/CANL or GND, bus load, or a "
-                         "gimbal that goes silent", data)
+            summary += f"; {refused} refused"
+            hints.append("the gimbal refuses commands: motors off, calibrating, or in a mode that ignores "
+                         "the R SDK (another controller in charge?)")
         if p99 > SLOW_P99_MS:
-            return Check("latency", False, summary,
-                         f"replies slower than the client's {SLOW_P99_MS:.0f} ms timeout: a slow adapter or "
-                         "driver (slcan polling), or a loaded bus; track will retry", data)
+            hints.append(f"replies slower than the client's {SLOW_P99_MS:.0f} ms timeout: a slow adapter or "
+                         "driver, or a loaded bus; track will retry")
+        if lost:
+            summary += f"; {lost} unanswered within {QUERY_TIMEOUT_S * 1000:.0f} ms"
+            hints.append("frames are lost: termination (120 Ω), a loose CANH/CANL or GND, bus load, or a "
+                         "gimbal that goes silent")
+        if hints:
+            return Check("latency", False, summary, "; ".join(hints), data)
         return Check("latency", True, summary, data=data)
 
     def push_rate(self, window: float = PUSH_WINDOW_S) -> Check:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import time
 from contextlib import ExitStack
 from typing import Any
 
@@ -62,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     where = "built-in simulated gimbal" if args.interface == SIM_INTERFACE else \
         " ".join(str(v) for v in (args.interface or "python-can's configured bus", args.channel) if v)
     checks: list[Check] = []
+    started = time.monotonic()
 
     def report(check: Check) -> None:
         checks.append(check)
@@ -77,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
                     raise  # an option the simulator refuses: bad input, not a rig problem
                 report(Check("bus", False, str(exc), "the adapter: plugged in, its name (-c), the "
                              "dialout group for serial ones, its driver (docs/hardware.md)"))
-                return _finish(args, where, checks)
+                return _finish(args, where, checks, started)
             census = BusCensus(args.tx_id, args.rx_id)
             try:
                 client = stack.enter_context(GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id,
@@ -95,15 +97,17 @@ def run(args: argparse.Namespace) -> int:
                              "bus-off (docs/hardware.md)"))
     except KeyboardInterrupt:  # the client has stopped the gimbal by now; what was checked still goes out
         if args.json:
-            _finish(args, where, [*checks, Check("run", False, "interrupted")])
+            _finish(args, where, [*checks, Check("run", False, "interrupted")], started)
         raise
-    return _finish(args, where, checks)
+    return _finish(args, where, checks, started)
 
 
-def _finish(args: argparse.Namespace, where: str, checks: list[Check]) -> int:
+def _finish(args: argparse.Namespace, where: str, checks: list[Check], started: float) -> int:
+    """The JSON, or the closing line; the exit status: 0 only when every check passed."""
     ok = all(check.ok for check in checks)
     if args.json:
-        result: dict[str, Any] = {"bus": where, "ok": ok, "checks": [c.as_dict() for c in checks]}
+        result: dict[str, Any] = {"bus": where, "ok": ok, "seconds": round(time.monotonic() - started, 2),
+                                  "checks": [c.as_dict() for c in checks]}
         print(json.dumps(result), flush=True)
     else:
         failed = sum(not c.ok for c in checks)
