@@ -23,7 +23,7 @@ import can
 from gimbal.client import GimbalClient, position_message
 from gimbal.errors import GimbalError, GimbalTimeoutError, ReturnCodeError
 from gimbal.framer import Dropped, PacketFramer
-from gimbal.messages import is_device_push, reply_key
+from gimbal.messages import decode_message, is_device_push, reply_key
 from gimbal.messages.firmware import LEGACY_ORDER_DOCUMENT, LEGACY_ORDER_YPR
 from gimbal.messages.motion import ANGLES_ATTITUDE, AxisDegrees, GetAngles
 from gimbal.messages.telemetry import ParameterPush
@@ -88,6 +88,7 @@ class BusCensus(can.Listener):
         self.foreign_ids: Counter[int] = Counter()
         self.packets_on: Counter[int] = Counter()  # DJI R SDK packets seen on other ids
         self.damaged: Counter[str] = Counter()  # the gimbal's bytes dropped, by reason
+        self.other_host_commands: Counter[str] = Counter()  # another host's packets on our tx id, by name
         self._framers: dict[int, PacketFramer] = {}
         self._lock = threading.Lock()
 
@@ -142,6 +143,11 @@ class BusCensus(can.Listener):
 
     def _other_host_packet(self, packet: Packet) -> None:
         self.counts["other_host_packets"] += 1
+        try:
+            name = decode_message(packet).NAME
+        except GimbalError:
+            name = "undecoded"
+        self.other_host_commands[name] += 1
 
 
 def _hex(can_id: int) -> str:
@@ -184,7 +190,7 @@ class Doctor:
         once the gimbal has not answered."""
         yield self.listen()
         yield self.version()
-        for step in (self.layout, self.latency, self.push_rate, self.camera, self.integrity):
+        for step in (self.latency, self.layout, self.push_rate, self.camera, self.integrity):
             if step is self.camera and not self.rig.camera:
                 continue
             yield step() if self.answering else Check(step.__name__.split("_")[0], False,
@@ -336,10 +342,11 @@ class Doctor:
     def other_controller(self) -> Check:
         counts = self.census.snapshot()
         frames, packets = counts["other_host_frames"], counts["other_host_packets"]
-        data = {"frames": frames, "packets": packets}
+        names = ", ".join(f"{n} {name}" for name, n in self.census.other_host_commands.most_common())
+        data = {"frames": frames, "packets": packets, "commands": dict(self.census.other_host_commands)}
         if frames:
-            return Check("controller", False, f"{packets} DJI R SDK commands ({frames} frames) on "
-                         f"{_hex(self.rig.tx_id)} that this run did not send",
+            return Check("controller", False, f"{packets} DJI R SDK commands ({names or 'none whole'}; "
+                         f"{frames} frames) on {_hex(self.rig.tx_id)} that this run did not send",
                          "another host drives this gimbal (another gimbaltrack, a script, a second "
                          "adapter): stop it, two controllers fight", data)
         return Check("controller", True, f"no other host sends on {_hex(self.rig.tx_id)}", data=data)

@@ -21,7 +21,7 @@ from gimbal.transport import packet_frames
 from pipelines.cli import main
 from tests.support import cli_command, free_udp_port, subprocess_env, wait_until
 
-ALL = ("listen", "version", "layout", "latency", "push", "camera", "integrity", "controller")
+ALL = ("listen", "version", "latency", "layout", "push", "camera", "integrity", "controller")
 
 
 def doctor(config: SimConfig = SimConfig(), faults: Faults = Faults(), rig: RigSettings = RigSettings(),
@@ -155,6 +155,7 @@ def test_another_controller_on_our_tx_id_is_found() -> None:
     assert not checks["controller"].ok
     assert checks["controller"].data["packets"] >= 3
     assert "another host" in checks["controller"].hint
+    assert checks["controller"].data["commands"]["get_angles"] >= 3
 
 
 def test_our_own_frames_are_not_another_controller_on_a_loopback_bus() -> None:
