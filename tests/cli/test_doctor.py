@@ -244,3 +244,13 @@ def test_cli_against_the_simulator_process_over_udp_multicast() -> None:
     assert all(c["ok"] for c in result["checks"])
     assert result["checks"][1]["data"]["foreign_frames"] > 0
     assert result["seconds"] < 10
+
+
+def test_cli_takes_the_rig_profile_sign_options(tmp_path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A profile's [gimbal] invert_yaw reaches the wiggle: the simulator turns the usual way, so it is red."""
+    profile = tmp_path / "rig.toml"
+    profile.write_text('[bus]\ninterface = "sim"\n[gimbal]\ninvert_yaw = true\n')
+    assert main(["doctor", "--profile", str(profile), "--wiggle", "--no-camera", "--json"]) == 1
+    result = json.loads(capsys.readouterr().out)
+    assert [c["name"] for c in result["checks"] if not c["ok"]] == ["yaw sign"]
+    assert "camera" not in [c["name"] for c in result["checks"]]
