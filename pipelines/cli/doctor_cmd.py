@@ -12,6 +12,7 @@ from typing import Any
 from gimbal.client import GimbalClient
 from gimbal.diagnostics import BusCensus, Check, Doctor, RigSettings
 from gimbal.errors import GimbalError
+from gimbal.signals import SignalExit
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
 from pipelines.cli.common import CliError, add_bus_options
 from pipelines.cli.firmware_opts import add_legacy_order_option
@@ -95,9 +96,10 @@ def run(args: argparse.Namespace) -> int:
             except GimbalError as exc:  # the bus lost mid-run: what was found so far, and this
                 report(Check("run", False, f"stopped: {exc}", "the bus went away: adapter unplugged or "
                              "bus-off (docs/hardware.md)"))
-    except KeyboardInterrupt:  # the client has stopped the gimbal by now; what was checked still goes out
-        if args.json:
-            _finish(args, where, [*checks, Check("run", False, "interrupted")], started)
+    except (KeyboardInterrupt, SignalExit) as exc:  # the client has stopped the gimbal by now
+        if args.json:  # what was checked still goes out
+            why = exc.signal_name if isinstance(exc, SignalExit) else "SIGINT"
+            _finish(args, where, [*checks, Check("run", False, f"interrupted ({why})")], started)
         raise
     return _finish(args, where, checks, started)
 

@@ -3,6 +3,7 @@ simulator fault turns its own check red with a hint, and the wiggle returns the 
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import threading
 import time
@@ -11,7 +12,7 @@ import can
 import pytest
 
 from gimbal.client import GimbalClient
-from gimbal.diagnostics import BusCensus, Check, Doctor, RigSettings
+from gimbal.diagnostics import BusCensus, Check, Doctor, RigSettings, wiggle_step
 from gimbal.matcher import FIRST_SEQ
 from gimbal.messages import message_packet
 from gimbal.messages.motion import ANGLES_ATTITUDE, GetAngles
@@ -19,7 +20,7 @@ from gimbal.packet import encode_packet
 from gimbal.sim import Faults, SimConfig, SimulatedGimbal
 from gimbal.transport import packet_frames
 from pipelines.cli import main
-from tests.support import cli_command, free_udp_port, subprocess_env, wait_until
+from tests.support import cli_command, free_udp_port, signalled, subprocess_env, wait_until
 
 ALL = ("listen", "version", "latency", "layout", "push", "camera", "integrity", "controller")
 
@@ -254,3 +255,63 @@ def test_cli_takes_the_rig_profile_sign_options(tmp_path, capsys: pytest.Capture
     result = json.loads(capsys.readouterr().out)
     assert [c["name"] for c in result["checks"] if not c["ok"]] == ["yaw sign"]
     assert "camera" not in [c["name"] for c in result["checks"]]
+
+
+def test_the_wiggle_steps_away_from_the_end_of_the_documents_range() -> None:
+    assert wiggle_step("yaw", 0.0) == 5.0
+    assert wiggle_step("yaw", 177.0) == -5.0
+    assert wiggle_step("pitch", 144.0) == -5.0
+    assert wiggle_step("pitch", -55.0) == 5.0
+
+
+def test_an_interrupted_wiggle_still_stops_returns_and_releases(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C during the speed nudge: the gimbal gets zero speed, control released, and its start."""
+    calls = []
+    speed = GimbalClient.speed
+
+    def interrupted(self: GimbalClient, *args: object, **kwargs: object) -> None:
+        calls.append(args)
+        speed(self, *args, **kwargs)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(GimbalClient, "speed", interrupted)
+    channel = f"doctor-interrupted-{time.monotonic_ns()}"
+    sim = SimulatedGimbal(can.Bus(interface="virtual", channel=channel), SimConfig(initial_joint_deg=(20.0, 0.0, 0.0)),
+                          shutdown_bus=True).start()
+    host = can.Bus(interface="virtual", channel=channel)
+    census = BusCensus()
+    try:
+        with pytest.raises(KeyboardInterrupt), GimbalClient(host, listeners=[census]) as client:
+            for _ in Doctor(client, census, RigSettings()).checks(wiggle=True):
+                pass
+        state = sim.state()
+    finally:
+        sim.stop()
+        host.shutdown()
+    assert len(calls) == 2
+    assert not state.speed_control and state.speeds == (0.0, 0.0, 0.0)
+    assert state.joint[0] == pytest.approx(20.0, abs=0.2) and state.joint[2] == pytest.approx(0.0, abs=0.2)
+
+
+@pytest.mark.parametrize(("signum", "status", "said"), [(signal.SIGINT, 130, "interrupted"),
+                                                          (signal.SIGTERM, 143, "terminated (SIGTERM)")])
+def test_cli_stopped_by_a_signal_says_so_in_one_line(signum: int, status: int, said: str) -> None:
+    code, out, err = signalled(cli_command("doctor", "-i", "sim"), lambda p: p.stdout.readline().startswith("✓ bus"),
+                               signum, env=subprocess_env())
+    assert code == status
+    assert err.strip().splitlines() == [f"gimbaltrack doctor: {said}"]
+
+
+def test_cli_interrupted_still_prints_the_json_of_what_was_checked(monkeypatch: pytest.MonkeyPatch,
+                                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    def interrupted(self: Doctor, queries: int = 50) -> Check:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Doctor, "latency", interrupted)
+    assert main(["doctor", "-i", "sim", "--json"]) == 130
+    captured = capsys.readouterr()
+    result = json.loads(captured.out)
+    assert [c["name"] for c in result["checks"]] == ["bus", "listen", "version", "run"]
+    assert result["ok"] is False and result["checks"][-1]["summary"] == "interrupted (SIGINT)"
+    assert captured.err.strip() == "gimbaltrack doctor: interrupted"
