@@ -95,8 +95,15 @@ class BusCensus(can.Listener):
         self._lock = threading.Lock()
 
     def snapshot(self) -> Counter[str]:
+        """A copy of ``counts``; the per-id and per-reason tables are read with ``tables``."""
         with self._lock:
             return Counter(self.counts)
+
+    def tables(self) -> tuple[Counter[int], Counter[int], Counter[str], Counter[str]]:
+        """Copies of ``foreign_ids``, ``packets_on``, ``damaged`` and ``other_host_commands``."""
+        with self._lock:
+            return (Counter(self.foreign_ids), Counter(self.packets_on), Counter(self.damaged),
+                    Counter(self.other_host_commands))
 
     def on_message_received(self, msg: can.Message) -> None:
         with self._lock:
@@ -159,7 +166,7 @@ def _hex(can_id: int) -> str:
 def nothing_answers_hint(census: BusCensus, rig: RigSettings) -> str:
     """Why a gimbal may not answer, most specific first: replies on another id, ids or bitrate not
     the document's, a bus that carries other traffic, or a silent bus."""
-    elsewhere = [i for i, n in census.packets_on.most_common() if n]
+    elsewhere = [i for i, n in census.tables()[1].most_common() if n]
     if elsewhere:
         return (f"DJI R SDK packets arrive on {', '.join(map(_hex, elsewhere))}, not on --rx-id "
                 f"{_hex(rig.rx_id)}: set --rx-id (and --tx-id) to the gimbal's")
@@ -209,11 +216,12 @@ class Doctor:
         before = self.census.snapshot()
         time.sleep(seconds)
         seen = self.census.snapshot() - before
-        foreign = ", ".join(_hex(i) for i in sorted(self.census.foreign_ids)) or "none"
+        foreign_ids = sorted(self.census.tables()[0])
+        foreign = ", ".join(map(_hex, foreign_ids)) or "none"
         summary = (f"{seconds:g} s: {seen['gimbal_packets']} DJI R SDK packets, {seen['foreign_frames']} "
                    f"foreign frames (ids {foreign}), {seen['error_frames']} error frames")
         data = {"seconds": seconds, "sdk_packets": seen["gimbal_packets"], "foreign_frames": seen["foreign_frames"],
-                "foreign_ids": [_hex(i) for i in sorted(self.census.foreign_ids)],
+                "foreign_ids": [_hex(i) for i in foreign_ids],
                 "error_frames": seen["error_frames"], "other_host_frames": seen["other_host_frames"]}
         if seen["error_frames"]:
             return Check("listen", False, summary, "error frames: a bitrate that differs from the bus's "
@@ -334,10 +342,10 @@ class Doctor:
 
     def integrity(self) -> Check:
         """Damaged packets from the gimbal over the whole run."""
-        damaged = sum(self.census.damaged.values())
-        data = {"damaged": dict(self.census.damaged)}
+        damaged = self.census.tables()[2]
+        data = {"damaged": dict(damaged)}
         if damaged:
-            reasons = ", ".join(f"{n} {r}" for r, n in self.census.damaged.most_common())
+            reasons = ", ".join(f"{n} {r}" for r, n in damaged.most_common())
             return Check("integrity", False, f"damaged bytes from the gimbal: {reasons}",
                          "noise or bit errors: termination (120 Ω at the adapter), GND, cable length, "
                          "a bitrate near but not at 1 Mbit/s", data)
@@ -347,8 +355,9 @@ class Doctor:
     def other_controller(self) -> Check:
         counts = self.census.snapshot()
         frames, packets = counts["other_host_frames"], counts["other_host_packets"]
-        names = ", ".join(f"{n} {name}" for name, n in self.census.other_host_commands.most_common())
-        data = {"frames": frames, "packets": packets, "commands": dict(self.census.other_host_commands)}
+        commands = self.census.tables()[3]
+        names = ", ".join(f"{n} {name}" for name, n in commands.most_common())
+        data = {"frames": frames, "packets": packets, "commands": dict(commands)}
         if frames:
             return Check("controller", False, f"{packets} DJI R SDK commands ({names or 'none whole'}; "
                          f"{frames} frames) on {_hex(self.rig.tx_id)} that this run did not send",

@@ -20,12 +20,21 @@ from gimbal.packet import encode_packet
 from gimbal.sim import Faults, SimConfig, SimulatedGimbal
 from gimbal.transport import packet_frames
 from pipelines.cli import main
-from tests.support import cli_command, free_udp_port, signalled, subprocess_env, wait_until
+from tests.support import (
+    cli_command,
+    free_udp_port,
+    signalled,
+    subprocess_env,
+    wait_until,
+)
 
 ALL = ("listen", "version", "latency", "layout", "push", "camera", "integrity", "controller")
 
 
-def doctor(config: SimConfig = SimConfig(), faults: Faults = Faults(), rig: RigSettings = RigSettings(),
+DEFAULT_CONFIG, NO_FAULTS, DEFAULT_RIG = SimConfig(), Faults(), RigSettings()
+
+
+def doctor(config: SimConfig = DEFAULT_CONFIG, faults: Faults = NO_FAULTS, rig: RigSettings = DEFAULT_RIG,
            wiggle: bool = False, channel: str | None = None) -> tuple[dict[str, Check], SimulatedGimbal]:
     """The checks (by name) of a doctor run against a simulated gimbal on a fresh virtual channel."""
     channel = channel or f"doctor-{time.monotonic_ns()}"
@@ -236,7 +245,7 @@ def test_cli_against_the_simulator_process_over_udp_multicast() -> None:
         assert wait_until(lambda: sim.stdout.readline(), 60), "the simulator never started"
         threading.Thread(target=sim.stdout.read, daemon=True).start()  # an unread pipe would stall it
         done = subprocess.run(cli_command("doctor", "-i", "udp_multicast", "-c", group, "--json"),
-                              capture_output=True, text=True, env=env, timeout=120)
+                              capture_output=True, text=True, env=env, timeout=120, check=False)
     finally:
         sim.terminate()
         sim.wait(30)
@@ -297,7 +306,7 @@ def test_an_interrupted_wiggle_still_stops_returns_and_releases(monkeypatch: pyt
 @pytest.mark.parametrize(("signum", "status", "said"), [(signal.SIGINT, 130, "interrupted"),
                                                           (signal.SIGTERM, 143, "terminated (SIGTERM)")])
 def test_cli_stopped_by_a_signal_says_so_in_one_line(signum: int, status: int, said: str) -> None:
-    code, out, err = signalled(cli_command("doctor", "-i", "sim"), lambda p: p.stdout.readline().startswith("✓ bus"),
+    code, _, err = signalled(cli_command("doctor", "-i", "sim"), lambda p: p.stdout.readline().startswith("✓ bus"),
                                signum, env=subprocess_env())
     assert code == status
     assert err.strip().splitlines() == [f"gimbaltrack doctor: {said}"]
