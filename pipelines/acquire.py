@@ -4,9 +4,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from tracker.boxes import Box, center, iou
-from tracker.detectors import Detection
+
+if TYPE_CHECKING:  # the tracker and detectors load OpenCV and SciPy: only a run needs them
+    import numpy as np
+
+    from tracker.detectors import Detection, Detector
+    from tracker.estimate import TargetEstimate
+    from tracker.subject import SubjectTracker
 
 PICKS = ("central", "largest")
 CAMERA_MOTION_FRACTION = 0.10  # motion over more of the frame than this: the camera moved
@@ -150,3 +157,53 @@ def check_roi_in_frame(roi: tuple[int, int, int, int], size: tuple[int, int]) ->
     if x1 <= x0 or y1 <= y0 or (x1 - x0) * (y1 - y0) < 0.5 * w * h:
         raise ValueError(f"--roi {x},{y},{w},{h} lies {'outside' if x1 <= x0 or y1 <= y0 else 'mostly outside'} "
                          f"the {width}x{height} frame")
+
+
+class AcquiringSubject:
+    """The subject of a ``track`` run (a ``pipelines.loop.Subject``): none until a start box comes
+    (the user's ``--roi``, an operator's, or a confirmed detection by the ``pick`` rule, looked for
+    on every frame while none is chosen: the motion detector needs consecutive frames), then the
+    tracker. A lost subject is found again by the tracker, which runs ``detector`` itself: a
+    detection that looks like it, never merely the nearest one, so the subject's look is kept and
+    another person's is not taken for it."""
+
+    def __init__(self, tracker: SubjectTracker, detector: Detector | None, frame_size: tuple[int, int], *,
+                 roi: Box | None = None, pick: str = "central", confirmer: StartConfirmer | None = None) -> None:
+        self.tracker = tracker
+        self.detector = detector
+        self.frame_size = frame_size
+        self.pick = pick
+        self.confirmer = confirmer or StartConfirmer()
+        self.candidates: tuple[Detection, ...] = ()
+        self._start: Box | None = roi
+        self._estimate: TargetEstimate | None = None
+
+    @property
+    def name(self) -> str:
+        return self.tracker.name
+
+    def start(self, box: Box) -> None:
+        """Start the tracker afresh on ``box`` at the next frame."""
+        self._start = tuple(box)
+
+    def estimate(self, image: np.ndarray, t: float) -> TargetEstimate | None:
+        self.candidates = ()
+        if self._start is None and self._estimate is None:
+            self._start = self._detect(image)
+            if self._start is None:
+                return None
+        if self._start is not None:
+            box, self._start = self._start, None
+            self._estimate = self.tracker.init(image, box, t)
+        else:
+            self._estimate = self.tracker.update(image, t)
+        return self._estimate
+
+    def _detect(self, image: np.ndarray) -> Box | None:
+        """A confirmed detection to start on, by the pick rule."""
+        if self.detector is None:
+            return None
+        self.candidates = tuple(self.detector.detect(image))
+        confirmed = self.confirmer.offer(self.candidates, self.frame_size)
+        found = pick_candidate(confirmed, self.frame_size, self.pick)
+        return None if found is None else tuple(found.box)

@@ -1,5 +1,6 @@
-"""The whole loop on a recorded sequence: virtual camera -> tracker -> controller -> GimbalClient
--> CAN (python-can ``virtual``) -> simulated gimbal, whose attitude turns the virtual camera.
+"""The run behind ``gimbaltrack simulate``: the shared ``Loop`` on a recorded sequence seen through
+a virtual camera: view -> tracker -> controller -> GimbalClient -> CAN (python-can ``virtual``) ->
+simulated gimbal, whose attitude turns the virtual camera.
 
 Runs in real time (the client's keep-alive and the simulator run on the wall clock). Each frame
 is captured (rendered at the simulator's true attitude), handed to the tracker ``latency_s``
@@ -19,15 +20,17 @@ from pathlib import Path
 import numpy as np
 
 from gimbal.client import GimbalClient
-from gimbal.messages.telemetry import ParameterPush
 from gimbal.sim import SimConfig, start_in_process
-from pipelines.control.attitude import AttitudeHistory
 from pipelines.control.controller import ControlConfig, Controller, RateCommand, make_controller
+from pipelines.control.gimbal_link import GimbalLink
 from pipelines.control.metrics import CentringSample, summarize
+from pipelines.loop import Loop
+from pipelines.sources import Frame
 from pipelines.virtual_camera import VirtualCamera
 from tracker import SubjectTracker, make_tracker
 from tracker.boxes import Box, center, start_box
 from tracker.datasets import Sequence, load_sequence
+from tracker.detectors import Detection
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.evaluation import first_box
 from tracker.metrics import has_truth
@@ -79,6 +82,43 @@ class OracleTracker:
             found = 0 <= cx < self.width and 0 <= cy < self.height
         return TargetEstimate(box or (0.0, 0.0, 0.0, 0.0), (0.0, 0.0), 1.0 if found else 0.0,
                               TrackState.TRACKING if found else TrackState.LOST, timestamp, index)
+
+
+class SimulatedSubject:
+    """What the loop follows in a simulation (a ``pipelines.loop.Subject``): the oracle's estimate
+    of the frame's ground truth, or a real tracker, started on the first view's ground truth (that
+    first frame's estimate is the oracle's). The driver sets ``truth`` and ``index`` before each step."""
+
+    candidates: tuple[Detection, ...] = ()
+
+    def __init__(self, oracle: OracleTracker, tracker: SubjectTracker | None) -> None:
+        self.oracle = oracle
+        self.tracker = tracker
+        self.truth: Box | None = None
+        self.index = 0
+        self._start: Box | None = None
+
+    @property
+    def name(self) -> str:
+        return ORACLE if self.tracker is None else self.tracker.name
+
+    def start(self, box: Box) -> None:
+        """Start the tracker afresh on ``box`` at the next frame (the oracle needs no start)."""
+        if self.tracker is None:
+            raise ValueError("the oracle follows the ground truth: it takes no start box")
+        self._start = tuple(box)
+
+    def estimate(self, image: np.ndarray, t: float) -> TargetEstimate:
+        oracle = self.oracle.estimate(self.truth, t, self.index)
+        if self.tracker is None:
+            return oracle
+        if self.index == 0:
+            self.tracker.init(image, self.truth, t)
+            return oracle
+        if self._start is not None:
+            box, self._start = self._start, None
+            return self.tracker.init(image, box, t)
+        return self.tracker.update(image, t)
 
 
 @dataclass
@@ -158,34 +198,23 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
 def run_prepared(loop: PreparedLoop) -> LoopResult:
     """Run a prepared loop; see the module doc."""
     settings, seq, frames, first, vc = loop.settings, loop.seq, loop.frames, loop.first, loop.vc
-    controller, subject = loop.controller, loop.subject
-    oracle = OracleTracker(vc.camera.width, vc.camera.height)
+    subject = SimulatedSubject(OracleTracker(vc.camera.width, vc.camera.height), loop.subject)
 
     host_bus, sim = start_in_process(SIM_CONFIG)
     steps: list[LoopStep] = []
     try:
         with GimbalClient(host_bus) as client:
-            history = AttitudeHistory()
-            history.attach(client)
-            client.wait_for_push(ParameterPush, 1.0)
-            streamer = client.speed_streamer()
+            link = GimbalLink(client)
+            link.start(wait_s=1.0)
+            closed = Loop(subject, loop.controller, link)
             pending: deque[_Captured] = deque()
             t0 = time.monotonic() + 0.05
             truth = iter(seq.groundtruth)
 
             def process(item: _Captured) -> None:
-                if subject is None:
-                    est = oracle.estimate(item.box, item.t, item.index)
-                elif item.index == 0:
-                    subject.init(item.view, item.box, item.t)
-                    est = oracle.estimate(item.box, item.t, item.index)
-                else:
-                    est = subject.update(item.view, item.t)
-                att = history.at(item.t)
-                now = time.monotonic()
-                cmd = controller.update(est, None if att is None else (att.yaw, att.pitch), now)
-                streamer.set(cmd.yaw_dps, cmd.pitch_dps, stamp=item.t)
-                steps.append(LoopStep(item.t - t0, item.sample, cmd))
+                subject.truth, subject.index = item.box, item.index
+                record = closed.step(Frame(item.view, item.t, item.index), item.t)
+                steps.append(LoopStep(item.t - t0, item.sample, record.command))
 
             frame: np.ndarray | None = first
             index = 0
@@ -203,11 +232,10 @@ def run_prepared(loop: PreparedLoop) -> LoopResult:
                 pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box, sample))
                 index += 1
                 frame = next(frames, None)
-            streamer.stop()
-            latencies = streamer.latencies()
+            link.stop()
+            latencies = link.latencies()
     finally:
         sim.stop()
         host_bus.shutdown()
-    used = replace(settings, tracker=ORACLE if subject is None else subject.name, hfov_deg=vc.camera.hfov_deg)
+    used = replace(settings, tracker=subject.name, hfov_deg=vc.camera.hfov_deg)
     return LoopResult(used, steps, summarize([s.sample for s in steps]), latencies)
-

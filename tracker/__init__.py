@@ -1,5 +1,23 @@
-"""Vision tracker: detectors, tracking backends, re-acquisition, box Kalman, datasets, metrics."""
-from tracker.registry import available_trackers, make_tracker
-from tracker.subject import SubjectTracker
+"""Vision tracker: detectors, tracking backends, re-acquisition, box Kalman, datasets, metrics.
 
-__all__ = ["SubjectTracker", "available_trackers", "make_tracker"]
+The names below are loaded on first use (module ``__getattr__``): importing a light module such as
+``tracker.boxes`` does not load the backends' OpenCV and SciPy."""
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+_HOMES = {"SubjectTracker": "subject", "available_trackers": "registry", "make_tracker": "registry"}
+__all__ = sorted(_HOMES)
+
+if TYPE_CHECKING:
+    from tracker.registry import available_trackers, make_tracker
+    from tracker.subject import SubjectTracker
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _HOMES:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{_HOMES[name]}"), name)
+    globals()[name] = value
+    return value

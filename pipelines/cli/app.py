@@ -3,21 +3,19 @@
 from __future__ import annotations
 
 import argparse
-import errno
 import importlib
-import io
 import logging
-import os
-import signal
 import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 from gimbal.signals import SignalExit, blocked_signals, exit_on_signals
-from pipelines.cli.common import EXIT_INTERRUPTED, CliError, hold_on_devnull
+from pipelines.cli.common import EXIT_INTERRUPTED, CliError
+from pipelines.cli.process import drop_stdout, quiet_opencv, release_signals, standard_streams
 from pipelines.cli.profile import Profile, add_profile_option, apply_profile, blame, profile_path, read_profile
 
-# Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
+# Each module defines ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``;
+# module ``pipelines.cli.NAME_cmd`` is the command NAME.
 SUBCOMMAND_MODULES = [
     "pipelines.cli.eval_cmd",
     "pipelines.cli.track_cmd",
@@ -29,9 +27,62 @@ SUBCOMMAND_MODULES = [
     "pipelines.cli.config_cmd",
     "pipelines.cli.doctor_cmd",
 ]
+#: Each command's line in ``gimbaltrack --help``, as its module registers it (a test checks they
+#: agree): the list is shown without importing the modules, which load OpenCV and SciPy.
+COMMAND_HELP = {
+    "eval": "score a tracker on sequences with ground truth (precision@20px, success AUC, fps)",
+    "track": "track a subject in video and keep it framed with the gimbal",
+    "decode": "decode DJI R SDK packets from hex or a CAN log into JSON lines",
+    "replay": "play a recorded CAN log back: decoded packets, a summary, optionally onto a bus",
+    "sim": "run the simulated DJI RS gimbal on a CAN bus",
+    "gimbal": "talk to a DJI RS gimbal: read, move, set, camera",
+    "simulate": "run tracker + control + client against the simulated gimbal on a sequence",
+    "config": "print the effective settings (rig profile, python-can configuration, defaults)",
+}
 
 
-def build_parser() -> argparse.ArgumentParser:
+def command_name(module: str) -> str:
+    return module.rsplit(".", 1)[-1].removesuffix("_cmd")
+
+
+class LazySubcommands(argparse._SubParsersAction):
+    """Subcommands whose modules are imported when the command is chosen (``load``), so that
+    ``gimbaltrack gimbal ...`` never loads the tracker's OpenCV and SciPy, and ``gimbaltrack --help``
+    lists the commands from ``COMMAND_HELP`` alone."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)
+        self.unloaded: dict[str, str] = {}  # command -> its module, not imported yet
+
+    def add_lazy(self, module: str) -> None:
+        name = command_name(module)
+        self.add_parser(name, help=COMMAND_HELP[name], add_help=False)  # a stand-in with the help line
+        self.unloaded[name] = module
+
+    def load(self, name: str) -> argparse.ArgumentParser:
+        """The command's real parser, its module imported and registered on first use."""
+        module = self.unloaded.pop(name, None)
+        if module is not None:
+            del self._name_parser_map[name]
+            lines = len(self._choices_actions)
+            importlib.import_module(module).register(self)
+            del self._choices_actions[lines:]  # the stand-in's line stays, in its place
+            _add_common_options(self._name_parser_map[name])
+        return self._name_parser_map[name]
+
+    def load_all(self) -> None:
+        for name in list(self.unloaded):
+            self.load(name)
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: list[str], option_string: str | None = None) -> None:
+        self.load(values[0])
+        super().__call__(parser, namespace, values, option_string)
+
+
+def build_parser(lazy: bool = False) -> argparse.ArgumentParser:
+    """The ``gimbaltrack`` parser; ``lazy``: each command's module is imported only when the
+    command is parsed (``subcommands(parser).load_all()`` imports them all)."""
     parser = argparse.ArgumentParser(
         prog="gimbaltrack",
         description="Keep a subject framed with a DJI RS gimbal: track it in video, "
@@ -39,17 +90,28 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_logging_options(parser, False)
     add_profile_option(parser)
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in SUBCOMMAND_MODULES:
-        importlib.import_module(name).register(subparsers)
-    pending = list(subparsers.choices.values())
-    while pending:  # after the command too, at any depth: gimbaltrack gimbal angles --debug
-        subparser = pending.pop()
-        _add_logging_options(subparser, argparse.SUPPRESS)
-        add_profile_option(subparser, argparse.SUPPRESS)
-        pending += [p for action in subparser._actions if isinstance(action, argparse._SubParsersAction)
-                    for p in action.choices.values()]
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, action=LazySubcommands)
+    for module in SUBCOMMAND_MODULES:
+        subparsers.add_lazy(module)
+    if not lazy:
+        subparsers.load_all()
     return parser
+
+
+def subcommands(parser: argparse.ArgumentParser) -> LazySubcommands:
+    return next(a for a in parser._actions if isinstance(a, LazySubcommands))
+
+
+def _add_common_options(subparser: argparse.ArgumentParser) -> None:
+    """The logging and profile options on a command and, at any depth, its own subcommands (given
+    after the command too: gimbaltrack gimbal angles --debug)."""
+    pending = [subparser]
+    while pending:
+        current = pending.pop()
+        _add_logging_options(current, argparse.SUPPRESS)
+        add_profile_option(current, argparse.SUPPRESS)
+        pending += [p for action in current._actions if isinstance(action, argparse._SubParsersAction)
+                    for p in action.choices.values()]
 
 
 def _add_logging_options(parser: argparse.ArgumentParser, default: object) -> None:
@@ -58,25 +120,13 @@ def _add_logging_options(parser: argparse.ArgumentParser, default: object) -> No
     parser.add_argument("--debug", action="store_true", default=default, help="log debug output and show tracebacks")
 
 
-def quiet_opencv(argv: list[str]) -> None:
-    """Keep OpenCV's and FFmpeg's own warnings (``[ WARN:0@1.7] ...``, ``moov atom not found``) off
-    the terminal, where they bury the one-line error that explains them, unless ``--debug`` is
-    given or the variables are set already. Effective only before cv2 is imported."""
-    if "--debug" not in argv:
-        os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
-        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "8")  # AV_LOG_FATAL
-
-
 def main(argv: list[str] | None = None, release: Iterable[int] | None = None) -> int:
     """Parse ``argv`` and run the subcommand; its exit status. ``release``: the signal mask to go
     back to once the handlers are in place, when the caller holds the signals already."""
     given = sys.argv[1:] if argv is None else argv
     run = _Run(debug="--debug" in given)  # until parsed: an OSError may come first
-    if sys.stderr is None:  # fd 2 closed (2>&-): print(file=None) wrote the errors among the results
-        sys.stderr = closed_stderr()
+    standard_streams()
     quiet_opencv(given)
-    if sys.stdout is None:  # fd 1 closed (>&-): Python gives no stdout, and print() drops the results
-        sys.stdout = ClosedStdout()
     try:
         status = _run(argv, release, run)
     except SystemExit:  # argparse's --help (0) or usage error (2): its text is flushed here, not at exit
@@ -101,14 +151,14 @@ def _run(argv: list[str] | None, release: Iterable[int] | None, run: _Run) -> in
     try:
         with exit_on_signals():  # from the start: a SIGTERM while loading must not be a traceback
             try:
-                with blocked_signals():  # nor lost, or an import error, while numpy, SciPy and cv2 load
-                    parser = build_parser()
-            finally:
-                if release is not None:  # what arrived while the console script held them comes now
-                    signal.pthread_sigmask(signal.SIG_SETMASK, release)
+                with blocked_signals():  # nor lost, or an import error, while the modules load
+                    parser = build_parser(lazy=True)
+            finally:  # what arrived while the console script held them comes now
+                release_signals(release)
             given = sys.argv[1:] if argv is None else argv
             profile = _profile(given, parser, run)
-            args = parser.parse_args(argv)
+            with blocked_signals():  # the chosen command's module loads while parsing
+                args = parser.parse_args(argv)
             run.prog, run.debug = f"gimbaltrack {args.command}", args.debug
             level = logging.DEBUG if args.debug else logging.WARNING if args.verbose else logging.ERROR
             logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
@@ -128,7 +178,7 @@ def _run(argv: list[str] | None, release: Iterable[int] | None, run: _Run) -> in
         print(f"{run.prog}: terminated ({exc.signal_name})", file=sys.stderr)
         return int(exc.code)
     except BrokenPipeError:  # the reader went away (e.g. `| head`): not an error of ours
-        _drop_stdout()
+        drop_stdout()
         return 0
     except OSError as exc:  # one no subcommand words itself, e.g. stdout on a full disk (> /dev/full)
         return _unwritten(run.prog, exc, run.debug)
@@ -140,6 +190,8 @@ def _profile(argv: list[str], parser: argparse.ArgumentParser, run: _Run) -> Pro
     path = profile_path(argv)
     if path is None:
         return None
+    with blocked_signals():  # a profile may name any command's options: all are loaded
+        subcommands(parser).load_all()
     try:
         profile = read_profile(path, parser)
     except CliError as exc:
@@ -161,7 +213,7 @@ def _flushed(run: _Run, status: int) -> int:
     try:
         sys.stdout.flush()
     except BrokenPipeError:
-        _drop_stdout()
+        drop_stdout()
     except OSError as exc:
         failed = _unwritten(run.prog, exc, run.debug)  # said whatever the status
         return status or failed
@@ -177,47 +229,5 @@ def _unwritten(prog: str, exc: OSError, debug: bool) -> int:
     try:
         sys.stdout.flush()
     except OSError:
-        _drop_stdout()
+        drop_stdout()
     return 1
-
-
-STDOUT_FD, STDERR_FD = 1, 2
-
-
-def closed_stderr() -> io.TextIOBase:
-    """``sys.stderr`` when fd 2 was closed (``2>&-``), where Python gives None and ``print(...,
-    file=sys.stderr)`` writes to stdout: the user chose not to see the errors, so they go to
-    /dev/null, never among the results; the exit status still tells a failure."""
-    hold_on_devnull(STDERR_FD)
-    return open(STDERR_FD, "w", closefd=False)
-
-
-class ClosedStdout(io.TextIOBase):
-    """``sys.stdout`` when fd 1 was closed (``>&-``). It holds fd 1 open on /dev/null, so that no
-    output file opened later takes that number, and flushing what was written raises EBADF: a
-    closed stdout is reported like a full disk's (one line, exit 1), and a run's files are kept."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        hold_on_devnull(STDOUT_FD)
-        self._written = False
-
-    def writable(self) -> bool:
-        return True
-
-    def fileno(self) -> int:
-        return STDOUT_FD
-
-    def write(self, text: str) -> int:
-        self._written = self._written or bool(text)
-        return len(text)
-
-    def flush(self) -> None:
-        if self._written:  # said once: the flush at exit finds nothing more
-            self._written = False
-            raise OSError(errno.EBADF, "stdout is closed: the results went nowhere")
-
-
-def _drop_stdout() -> None:
-    """Point stdout at /dev/null, so that Python's own flush at exit cannot fail a second time."""
-    hold_on_devnull(sys.stdout.fileno())

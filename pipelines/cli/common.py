@@ -18,16 +18,6 @@ class CliError(Exception):
         self.exit_code = exit_code
 
 
-def hold_on_devnull(fd: int) -> None:
-    """Open /dev/null on ``fd``: one closed when the program started, so that no output file opened
-    later takes that number (and gets what is written to stdout or stderr, OpenCV's own included),
-    or one whose writes failed, so that nothing written later fails again."""
-    null = os.open(os.devnull, os.O_WRONLY)
-    if null != fd:
-        os.dup2(null, fd)
-        os.close(null)
-
-
 def make_out_dir(out: Path) -> None:
     """Create an ``--out`` folder before any work, so that a bad one fails at once, in one line."""
     if out.exists() and not out.is_dir():

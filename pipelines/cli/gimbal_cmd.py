@@ -37,9 +37,10 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
 from gimbal.session import MAX_TIMEOUT
 from pipelines.cli.bus import open_host_bus
-from pipelines.cli.firmware_opts import add_legacy_order_option
-from pipelines.cli.common import (CliError, add_bus_options, hold_on_devnull, parse_int, parse_seconds,
+from pipelines.cli.common import (CliError, add_bus_options, parse_int, parse_seconds,
                                   suppress_defaults)
+from pipelines.cli.firmware_opts import add_legacy_order_option
+from pipelines.cli.process import hold_on_devnull
 
 Result = dict[str, Any]
 LIMITS = tuple(LIMIT_RANGES)

@@ -3,16 +3,10 @@ from __future__ import annotations
 
 import bisect
 from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass
 from operator import attrgetter
-from typing import TYPE_CHECKING
 
-from gimbal.messages.telemetry import ParameterPush
 from pipelines.control.direction import wrap_deg
-
-if TYPE_CHECKING:
-    from gimbal.client import GimbalClient
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,23 +41,6 @@ class AttitudeHistory:
         if self._samples and timestamp < self._samples[-1].timestamp:
             return
         self._samples.append(Attitude(wrap_deg(yaw), roll, pitch, timestamp))
-
-    def on_push(self, msg: ParameterPush, t: float) -> None:
-        """Callback for ``GimbalClient.on_push(ParameterPush, ...)``.
-
-        Skips pushes whose angle-valid flag is clear or that stop short of the attitude (short
-        pushes carrying the attitude but not the joint angles are used).
-        """
-        attitude = msg.attitude
-        if attitude is not None:
-            self.add(t, attitude.yaw, attitude.roll, attitude.pitch)
-
-    def attach(self, client: GimbalClient) -> Callable[[], None]:
-        """Record every ``ParameterPush`` ``client`` receives and enable the push; returns the
-        unsubscribe function."""
-        unsubscribe = client.on_push(ParameterPush, self.on_push)
-        client.set_push(True)
-        return unsubscribe
 
     def latest(self) -> Attitude | None:
         return self._samples[-1] if self._samples else None

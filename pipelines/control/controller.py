@@ -9,9 +9,9 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Protocol
 
-from gimbal.keepalive import DEFAULT_MAX_AGE_S
 from pipelines.control.camera import CameraModel
 from pipelines.control.direction import Direction, DirectionFilter, PredictionTrust, compose, wrap_deg
+from pipelines.control.gimbal_link import SETPOINT_MAX_AGE_S
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate
 from pipelines.control.pid import Pid
 from tracker.estimate import TargetEstimate, TrackState
@@ -39,7 +39,7 @@ class ControlConfig:
     trust_memory_s: float = 1.0  # memory of the prediction scoring (PredictionTrust)
     reversal_factor: float = 2.0  # scoring horizon += this * (time to reverse the target's speed)
     first_step_s: float = 1 / 30  # the first setpoint may step from rest by max_accel_dps2 * this
-    setpoint_max_age_s: float = DEFAULT_MAX_AGE_S  # the keep-alive streams zero once a setpoint is this old
+    setpoint_max_age_s: float = SETPOINT_MAX_AGE_S  # the keep-alive streams zero once a setpoint is this old
 
     def __post_init__(self) -> None:
         for name in self.__dataclass_fields__:

@@ -10,10 +10,12 @@ import math
 from collections import deque
 from dataclasses import dataclass, replace
 
-import numpy as np
-from filterpy.kalman import KalmanFilter
+from typing import TYPE_CHECKING
 
-from tracker.kalman import white_noise_q
+import numpy as np
+
+if TYPE_CHECKING:
+    from filterpy.kalman import KalmanFilter
 
 
 def wrap_deg(angle: float) -> float:
@@ -96,6 +98,7 @@ class DirectionFilter:
             self._kf.x[2] += dpitch
 
     def _start(self, z: tuple[float, float], t: float) -> None:
+        from filterpy.kalman import KalmanFilter  # noqa: PLC0415 (filterpy loads SciPy: only a run needs it)
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([z[0], 0.0, z[1], 0.0])
         kf.H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
@@ -111,9 +114,8 @@ class DirectionFilter:
             return
         kf.F = np.array([[1.0, dt, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0],
                          [0.0, 0.0, 1.0, dt], [0.0, 0.0, 0.0, 1.0]])
-        q = np.zeros((4, 4))
-        q[:2, :2] = q[2:, 2:] = white_noise_q(dt, self.accel_std_dps2 ** 2)  # yaw, then pitch
-        kf.Q = q
+        from filterpy.common import Q_discrete_white_noise  # noqa: PLC0415 (loaded by _start already)
+        kf.Q = Q_discrete_white_noise(dim=2, dt=dt, var=self.accel_std_dps2 ** 2, block_size=2)  # yaw, pitch
         kf.predict()
         self._t = t
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from gimbal.messages.limits import MAX_SPEED_DPS as PROTOCOL_MAX_SPEED_DPS
+from pipelines.control.gimbal_link import PROTOCOL_MAX_SPEED_DPS
 from pipelines.control.pid import clamp
 
 __all__ = ["PROTOCOL_MAX_SPEED_DPS", "limit_rate"]

@@ -9,6 +9,8 @@ from types import TracebackType
 import cv2
 import numpy as np
 
+from tracker.datasets import ASSUMED_FPS
+
 
 class SourceError(Exception):
     """A source cannot be opened or stopped delivering frames; the message is one line."""
@@ -50,6 +52,11 @@ class FrameSource(ABC):
     @property
     def fps(self) -> float | None:
         return self._fps
+
+    @property
+    def playback_fps(self) -> float:
+        """``fps``, or the rate assumed for a source that does not tell its own."""
+        return self._fps or ASSUMED_FPS
 
     @property
     def frame_count(self) -> int | None:

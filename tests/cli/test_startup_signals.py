@@ -45,9 +45,9 @@ def test_importing_the_command_changes_no_signal_handling() -> None:
 
 
 def test_the_held_signals_are_the_ones_the_command_handles() -> None:
-    import pipelines.cli
+    import pipelines.cli.process
 
-    assert pipelines.cli.HELD_SIGNALS == (signal.SIGINT, *TERMINATING_SIGNALS)
+    assert pipelines.cli.process.HELD_SIGNALS == (signal.SIGINT, *TERMINATING_SIGNALS)
 
 
 def test_python_dash_m_runs_the_command() -> None:

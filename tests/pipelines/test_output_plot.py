@@ -1,4 +1,4 @@
-"""Time-series plots drawn with OpenCV."""
+"""Time-series plots drawn with matplotlib."""
 from __future__ import annotations
 
 import math
@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 import pytest
 
-from pipelines.outputs.plot import PALETTE, nice_ticks, render_timeseries, write_timeseries_png
+from pipelines.outputs.plot import PALETTE, _figure, render_timeseries, write_timeseries_png
 
 
 def _colour_pixels(image: np.ndarray, colour: tuple[int, int, int]) -> int:
@@ -55,7 +55,15 @@ def test_bad_arguments(kwargs: dict, message: str) -> None:
         render_timeseries(**kwargs)
 
 
-def test_nice_ticks() -> None:
-    assert nice_ticks(0, 9.97, 5) == [0, 2, 4, 6, 8]
-    assert nice_ticks(-0.53, 1.27, 4) == [-0.5, 0, 0.5, 1.0]
-    assert nice_ticks(0.1, 0.13, 3) == pytest.approx([0.1, 0.11, 0.12, 0.13])
+def test_axes_are_labelled_and_the_series_named() -> None:
+    """What a reader needs on each panel: its title, the y unit, one legend entry per series, and
+    the time axis named once under the bottom panel; ticks are matplotlib's own."""
+    figure = _figure([0.0, 1.0, 2.0], [{"yaw": [0, 1, 2], "pitch": [2, 1, 0]}, {"rate": [1, 1, 1]}],
+                     ["angular error", "commanded rates"], ["deg", "deg/s"], "time (s)", 960, 240)
+    top, bottom = figure.axes
+    assert (top.get_title(), top.get_ylabel(), bottom.get_title(), bottom.get_ylabel()) == \
+        ("angular error", "deg", "commanded rates", "deg/s")
+    assert [t.get_text() for t in top.get_legend().get_texts()] == ["yaw", "pitch"]
+    assert [t.get_text() for t in bottom.get_legend().get_texts()] == ["rate"]
+    assert bottom.get_xlabel() == "time (s)" and top.get_xlabel() == ""
+    assert bottom.get_xlim() == (0.0, 2.0) and len(bottom.get_xticks()) >= 3

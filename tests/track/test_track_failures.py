@@ -17,7 +17,7 @@ from gimbal.client import GimbalClient
 from gimbal.errors import ReturnCodeError
 import pipelines.cli.bus
 import pipelines.cli.track_cmd
-import pipelines.track_session
+import pipelines.outputs.plot
 from gimbal.sim import Faults
 from pipelines.outputs.telemetry import read_telemetry
 from tests import fake_onnx
@@ -270,7 +270,7 @@ def plot_on_full_disk(monkeypatch: pytest.MonkeyPatch) -> None:
     def disk_full(*args: object, **kwargs: object) -> None:
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(pipelines.track_session, "write_timeseries_png", disk_full)
+    monkeypatch.setattr(pipelines.outputs.plot, "write_timeseries_png", disk_full)
 
 
 @pytest.mark.usefixtures("plot_on_full_disk")

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+import pipelines.cli.track_cmd  # noqa: F401 (loaded before the stream starts: the 7 s stream is for tracking, not start-up)
 from pipelines.outputs.telemetry import read_telemetry
 from tests.support import ROOT, free_udp_port, require_ffmpeg
 from tests.track.helpers import DEMO, assert_stopped_at_end, decoded, run_track, speed_commands

@@ -12,7 +12,7 @@ import cv2
 import pytest
 
 from pipelines.outputs.telemetry import TelemetryWriter, read_telemetry
-from pipelines.track_session import TrackSession
+from pipelines.acquire import AcquiringSubject
 from tests.track.helpers import assert_stopped_at_end, decoded, drifting, make_clip, roi_at, run_track
 
 FRAMES = 20
@@ -50,16 +50,16 @@ def test_a_source_failing_mid_run_stops_the_gimbal_and_exits_1(
 
 def test_a_crash_mid_run_stops_the_gimbal_and_keeps_the_outputs(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    real = TrackSession._track
+    real = AcquiringSubject.estimate
     calls: list[int] = []
 
-    def crash_on_the_eighth(self: TrackSession, *args: Any) -> Any:
+    def crash_on_the_eighth(self: AcquiringSubject, *args: Any) -> Any:
         calls.append(1)
         if len(calls) == 8:
             raise RuntimeError("a bug")
         return real(self, *args)
 
-    monkeypatch.setattr(TrackSession, "_track", crash_on_the_eighth)
+    monkeypatch.setattr(AcquiringSubject, "estimate", crash_on_the_eighth)
     clip = make_clip(tmp_path / "clip.avi", FRAMES, drifting)
     out = tmp_path / "out"
     with pytest.raises(RuntimeError, match="a bug"):  # a bug shows its traceback

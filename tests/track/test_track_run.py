@@ -16,7 +16,7 @@ from pipelines.cli import track_cmd
 from pipelines.cli.app import build_parser
 from pipelines.control import ControlConfig
 from pipelines.outputs.telemetry import read_telemetry
-from pipelines.track_session import signed_attitude
+from pipelines.control.gimbal_link import Signs
 from tests.support import require_ffmpeg
 from tests.track.helpers import (DEMO, DEMO_ROI, SIZE, assert_stopped_at_end, decoded,
                                  host_commands, in_speed_range, make_clip, roi_at, run_track,
@@ -227,4 +227,4 @@ def test_speed_and_attitude_signs_are_inverted_separately() -> None:
     args = build_parser().parse_args(["track", "clip.mp4", "--invert-yaw", "--invert-pitch-attitude"])
     options = track_cmd._options(args)
     assert (options.yaw_sign, options.pitch_sign) == (-1, 1)
-    assert signed_attitude(10.0, 5.0, options) == (10.0, -5.0)
+    assert options.signs == Signs(yaw_speed=-1, pitch_speed=1, yaw_attitude=1, pitch_attitude=-1)
