@@ -38,6 +38,7 @@ COMMAND_HELP = {
     "gimbal": "talk to a DJI RS gimbal: read, move, set, camera",
     "simulate": "run tracker + control + client against the simulated gimbal on a sequence",
     "config": "print the effective settings (rig profile, python-can configuration, defaults)",
+    "doctor": "check a gimbal rig: bus, ids, replies, latency, pushes, another controller",
 }
 
 
