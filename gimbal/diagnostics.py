@@ -24,13 +24,23 @@ from gimbal.client import GimbalClient, position_message
 from gimbal.errors import GimbalError, GimbalTimeoutError, ReturnCodeError
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.messages import decode_message, is_device_push, reply_key
+from gimbal.messages.external import DialPush, JoystickPush
 from gimbal.messages.firmware import LEGACY_ORDER_DOCUMENT, LEGACY_ORDER_YPR
 from gimbal.messages.limits import ANGLE_RANGES, TENTHS
-from gimbal.messages.motion import ANGLES_ATTITUDE, AxisDegrees, GetAngles
+from gimbal.messages.motion import (
+    ANGLES_ATTITUDE,
+    AxisDegrees,
+    GetAngles,
+    PositionControl,
+    SpeedControl,
+)
+from gimbal.messages.settings import ActiveTrack, RecenterSelfie
 from gimbal.messages.telemetry import ParameterPush
 from gimbal.packet import Packet
 from gimbal.transport import DEFAULT_BITRATE, HOST_RX_ID, HOST_TX_ID
 
+#: Commands that move the gimbal or take it over: another host sending one is another controller.
+CONTROL_COMMANDS = (SpeedControl, PositionControl, RecenterSelfie, JoystickPush, DialPush, ActiveTrack)
 LISTEN_S = 1.0  # the passive census at the start
 LATENCY_QUERIES = 50
 QUERY_TIMEOUT_S = 0.4  # one attitude query's wait; longer than the client's 0.1 s to measure slow replies
@@ -151,12 +161,17 @@ class BusCensus(can.Listener):
                 self.counts["short_replies"] += 1
 
     def _other_host_packet(self, packet: Packet) -> None:
+        if packet.is_reply:
+            return  # a gimbal answering on the host's id is no controller
         self.counts["other_host_packets"] += 1
         try:
-            name = decode_message(packet).NAME
+            message = decode_message(packet)
         except GimbalError:
-            name = "undecoded"
-        self.other_host_commands[name] += 1
+            self.other_host_commands["undecoded"] += 1
+            return
+        self.other_host_commands[message.NAME] += 1
+        if isinstance(message, CONTROL_COMMANDS):
+            self.counts["other_host_control"] += 1
 
 
 def _hex(can_id: int) -> str:
@@ -353,16 +368,22 @@ class Doctor:
         return Check("integrity", True, f"{packets} packets from the gimbal, none damaged", data=data)
 
     def other_controller(self) -> Check:
+        """Red when another host sends commands that move the gimbal or take it over; its queries
+        (a monitoring tool's) are only reported."""
         counts = self.census.snapshot()
-        frames, packets = counts["other_host_frames"], counts["other_host_packets"]
+        frames, packets, control = (counts["other_host_frames"], counts["other_host_packets"],
+                                    counts["other_host_control"])
         commands = self.census.tables()[3]
         names = ", ".join(f"{n} {name}" for name, n in commands.most_common())
-        data = {"frames": frames, "packets": packets, "commands": dict(commands)}
-        if frames:
+        data = {"frames": frames, "packets": packets, "control": control, "commands": dict(commands)}
+        if control:
             return Check("controller", False, f"{packets} DJI R SDK commands ({names or 'none whole'}; "
                          f"{frames} frames) on {_hex(self.rig.tx_id)} that this run did not send",
                          "another host drives this gimbal (another gimbaltrack, a script, a second "
                          "adapter): stop it, two controllers fight", data)
+        if frames:
+            return Check("controller", True, f"another host sends on {_hex(self.rig.tx_id)}, but no control "
+                         f"commands: {names or 'no whole packet'} ({frames} frames)", data=data)
         return Check("controller", True, f"no other host sends on {_hex(self.rig.tx_id)}", data=data)
 
     # -- moving (only with --wiggle) -----------------------------------------------------

@@ -14,8 +14,13 @@ import pytest
 from gimbal.client import GimbalClient
 from gimbal.diagnostics import BusCensus, Check, Doctor, RigSettings, wiggle_step
 from gimbal.matcher import FIRST_SEQ
-from gimbal.messages import message_packet
-from gimbal.messages.motion import ANGLES_ATTITUDE, GetAngles
+from gimbal.messages import Message, message_packet
+from gimbal.messages.motion import (
+    ANGLES_ATTITUDE,
+    SPEED_RELEASE,
+    GetAngles,
+    SpeedControl,
+)
 from gimbal.packet import encode_packet
 from gimbal.sim import Faults, SimConfig, SimulatedGimbal
 from gimbal.transport import packet_frames
@@ -143,11 +148,12 @@ def test_error_frames_turn_listen_red() -> None:
     assert not checks["listen"].ok and "bitrate" in checks["listen"].hint
 
 
-def test_another_controller_on_our_tx_id_is_found() -> None:
+def other_host_run(message: Message) -> dict[str, Check]:
+    """A doctor run while another host sends ``message`` on 0x223 five times a second."""
     channel = f"doctor-other-{time.monotonic_ns()}"
     other = can.Bus(interface="virtual", channel=channel)
     stop = threading.Event()
-    raw = encode_packet(message_packet(GetAngles(ANGLES_ATTITUDE), FIRST_SEQ + 0x100))
+    raw = encode_packet(message_packet(message, FIRST_SEQ + 0x100))
 
     def other_host() -> None:
         while not stop.wait(0.2):
@@ -162,10 +168,21 @@ def test_another_controller_on_our_tx_id_is_found() -> None:
         stop.set()
         sender.join()
         other.shutdown()
+    return checks
+
+
+def test_another_controller_on_our_tx_id_is_found() -> None:
+    checks = other_host_run(SpeedControl(0, 0, 0, SPEED_RELEASE))
     assert not checks["controller"].ok
-    assert checks["controller"].data["packets"] >= 3
+    assert checks["controller"].data["commands"]["speed_control"] >= 3
     assert "another host" in checks["controller"].hint
+
+
+def test_another_hosts_queries_are_reported_but_pass() -> None:
+    checks = other_host_run(GetAngles(ANGLES_ATTITUDE))
+    assert checks["controller"].ok
     assert checks["controller"].data["commands"]["get_angles"] >= 3
+    assert "no control commands" in checks["controller"].summary
 
 
 def test_our_own_frames_are_not_another_controller_on_a_loopback_bus() -> None:
