@@ -23,6 +23,7 @@ from gimbal.messages.motion import (
 )
 from gimbal.packet import encode_packet
 from gimbal.sim import Faults, SimConfig, SimulatedGimbal
+from gimbal.sim.slcan_pty import SlcanPty, virtual_pair
 from gimbal.transport import packet_frames
 from pipelines.cli import main
 from tests.support import (
@@ -74,6 +75,35 @@ def test_legacy_firmware_is_detected_and_passes() -> None:
     checks, _ = doctor(SimConfig(legacy=True))
     assert failed(checks) == set()
     assert checks["layout"].data["layout"] == "legacy"
+
+
+@pytest.mark.parametrize("config", [SimConfig(push_reply_bit=True), SimConfig(lenient=True)],
+                         ids=["push-reply-bit", "lenient"])
+def test_other_firmware_variants_pass(config: SimConfig) -> None:
+    checks, _ = doctor(config)
+    assert failed(checks) == set()
+
+
+@pytest.mark.parametrize(("bitrate", "passes"), [(1_000_000, True), (500_000, False)])
+def test_behind_the_slcan_adapter_only_the_gimbals_bitrate_reaches_it(bitrate: int, passes: bool) -> None:
+    """The slcan pseudo-terminal passes frames at 1 Mbit/s only, as a real bus does."""
+    pytest.importorskip("serial", reason="python-can's slcan interface needs pyserial")
+    adapter_bus, gimbal_bus = virtual_pair()
+    with SimulatedGimbal(gimbal_bus, SimConfig(), shutdown_bus=True), SlcanPty(adapter_bus) as pty:
+        bus = can.Bus(interface="slcan", channel=pty.path, bitrate=bitrate, sleep_after_open=0)
+        rig = RigSettings(bitrate=bitrate)
+        census = BusCensus()
+        try:
+            with GimbalClient(bus, listeners=[census]) as client:
+                checks = {c.name: c for c in Doctor(client, census, rig).checks()}
+        finally:
+            bus.shutdown()
+    adapter_bus.shutdown()
+    if passes:
+        assert failed(checks) == set()
+    else:
+        assert "version" in failed(checks)
+        assert checks["version"].hint.startswith("-b 500000 is not the gimbal's 1000000")
 
 
 LOSSY = {"push", "camera"}  # lost frames may cost these queries too
