@@ -5,7 +5,8 @@ Each check is bounded in time and ends in a ``Check`` (passed or not, what was s
 a hint naming the likely cause on a real rig). ``BusCensus`` is a ``can.Listener`` on the client's
 Notifier that counts every frame by what it is: the gimbal's packets, foreign frames (DJI's own
 accessory traffic), error frames, and frames on our transmit id that we did not send (another
-controller). No CLI here: ``pipelines.cli.doctor_cmd`` prints the results.
+host: a controller if it sends commands that move the gimbal). No CLI here:
+``pipelines.cli.doctor_cmd`` prints the results.
 """
 from __future__ import annotations
 
