@@ -2,10 +2,14 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
+from collections.abc import Iterator
 from pathlib import Path
+
+import numpy as np
 
 from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, prepare_loop, run_prepared
 from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
@@ -13,7 +17,8 @@ from pipelines.control.controller import controller_names
 from pipelines.control.metrics import MAX_ERROR, OVERSHOOT_WINDOW_S
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
-from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers
+from pipelines.progress import ProgressReporter
+from tracker.registry import DEFAULT_BACKEND, DEFAULT_MODEL_TRACKER, available_trackers
 
 
 MAX_LATENCY_MS = 2000.0  # far beyond any pipeline worth simulating; a typo must not sleep for hours
@@ -45,13 +50,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "or p (speed proportional to pixel error, the public-driver baseline)")
     parser.add_argument("--tracker", default="default", choices=[ORACLE, *available_trackers()], metavar="NAME",
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
-                        f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND}), "
+                        f"{DEFAULT_MODEL_TRACKER} on the model files shipped with gimbaltrack, else {DEFAULT_BACKEND}), "
                         f"or {ORACLE}: the ground-truth box is the detection, isolating the control loop")
     parser.add_argument("--model-dir", type=existing_dir, metavar="DIR",
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
-                        "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: none)")
+                        "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: the files shipped with gimbaltrack)")
     parser.add_argument("--fps", type=float, default=30.0, help="playback frame rate (default 30)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+    parser.add_argument("--quiet", action="store_true", help="no progress line (shown on a terminal only)")
     parser.add_argument("--out", type=out_dir, metavar="DIR",
                         help="write plot.png and summary.json here (default: none, nothing is written)")
     parser.set_defaults(func=run)
@@ -65,6 +71,29 @@ def _size(text: str) -> tuple[int, int]:
     if w <= 0 or h <= 0:
         raise argparse.ArgumentTypeError(f"size must be positive, got {text!r}")
     return w, h
+
+
+class _CountedFrames:
+    """A prepared loop's frames, counted on a progress line as the run takes them, as ``track``
+    shows its own (the loop runs in real time: a long sequence takes minutes)."""
+
+    def __init__(self, frames: Iterator[np.ndarray], progress: ProgressReporter) -> None:
+        self._frames = frames
+        self._progress = progress
+        self.taken = 1  # prepare_loop read the first
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        return self
+
+    def __next__(self) -> np.ndarray:
+        self._progress.update(self.taken)
+        frame = next(self._frames)
+        self.taken += 1
+        return frame
+
+    def close(self, status: str) -> None:
+        self._progress.update(self.taken, status, force=True)
+        self._progress.close()
 
 
 def summary_of(result: LoopResult) -> dict[str, object]:
@@ -105,7 +134,14 @@ def run(args: argparse.Namespace) -> int:
         loop = prepare_loop(args.sequence, settings)  # a bad sequence fails before --out is created
         if args.out:
             make_out_dir(args.out)
-        result = run_prepared(loop)
+        frames = _CountedFrames(loop.frames, ProgressReporter(len(loop.seq),
+                                                              enabled=not args.quiet and sys.stderr.isatty()))
+        status = "stopped"
+        try:
+            result = run_prepared(dataclasses.replace(loop, frames=frames))
+            status = "done"
+        finally:
+            frames.close(status)
     except (FileNotFoundError, ValueError) as exc:
         raise CliError(str(exc)) from exc
     except (KeyboardInterrupt, SystemExit):  # Ctrl-C, or SIGTERM/SIGHUP/SIGQUIT turned into SystemExit
