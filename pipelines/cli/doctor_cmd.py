@@ -13,7 +13,7 @@ from gimbal.client import GimbalClient
 from gimbal.diagnostics import BusCensus, Check, Doctor, RigSettings
 from gimbal.errors import GimbalError
 from gimbal.signals import SignalExit
-from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
+from pipelines.cli.bus import SIM_INTERFACE, bus_options, load_bus_config, open_host_bus
 from pipelines.cli.common import CliError, add_bus_options
 from pipelines.cli.firmware_opts import add_legacy_order_option
 
@@ -71,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
         if not args.json:
             print(line(check), flush=True)
 
+    if args.interface != SIM_INTERFACE:
+        load_bus_config(bus_options(args))  # a configuration naming no bus, or none: bad input (exit 2)
     try:
         with ExitStack() as stack:
             try:

@@ -282,6 +282,14 @@ def test_cli_a_bus_that_cannot_open_is_a_failed_check(capsys: pytest.CaptureFixt
     assert "cannot open the CAN bus" in result["checks"][0]["summary"]
 
 
+def test_cli_an_unknown_interface_is_bad_input_in_one_line(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["doctor", "-i", "nosuchbus", "-c", "x"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.strip().splitlines() == [
+        "gimbaltrack doctor: error: cannot open the CAN bus: unknown CAN interface: Unknown interface type \"nosuchbus\""]
+
+
 def test_cli_against_the_simulator_process_over_udp_multicast() -> None:
     """The issue's 'done when': doctor on udp_multicast against 'gimbaltrack sim' on that group."""
     group, env = "239.74.163.91", subprocess_env(free_udp_port())
