@@ -21,6 +21,7 @@ import numpy as np
 
 from gimbal.client import GimbalClient
 from gimbal.sim import SimConfig, start_in_process
+from gimbal.sim.model import GimbalModel
 from pipelines.control.controller import ControlConfig, Controller, RateCommand, make_controller
 from pipelines.control.gimbal_link import GimbalLink
 from pipelines.control.metrics import CentringSample, summarize
@@ -156,6 +157,18 @@ def _check_truth(seq: Sequence, tracked: bool) -> None:
         first_box(seq)
 
 
+def start_pointing(vc: VirtualCamera, seq: Sequence, config: SimConfig = SIM_CONFIG) -> SimConfig:
+    """``config`` with the gimbal's start pose turned to centre the first ground-truth box in the
+    view (pitch held within the simulated gimbal's range), so a subject that starts away from the
+    wide frame's centre is in view at the first frame instead of out of it."""
+    box = next(box for box in seq.groundtruth if has_truth(box))
+    yaw, pitch = vc.source.pixel_to_angles(*center(box))
+    pitch_range = GimbalModel(config, now=0.0).axis_range("pitch")
+    _, roll, _ = config.initial_joint_deg
+    pitch = min(max(pitch, pitch_range.low), pitch_range.high)
+    return replace(config, initial_joint_deg=(yaw - config.base_yaw_deg, roll, pitch))
+
+
 @dataclass
 class PreparedLoop:
     """A sequence loaded and checked, its first frame read, and the view, controller and tracker
@@ -169,6 +182,7 @@ class PreparedLoop:
     vc: VirtualCamera
     controller: Controller
     subject: SubjectTracker | None  # None: the oracle
+    sim_config: SimConfig  # the simulated gimbal, pointed at the first ground-truth box
 
 
 def prepare_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> PreparedLoop:
@@ -181,13 +195,14 @@ def prepare_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) 
     vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
     controller = make_controller(settings.controller, camera=vc.camera, config=settings.control)
     subject = None if settings.tracker == ORACLE else make_tracker(settings.tracker, settings.model_dir)
+    sim_config = start_pointing(vc, seq)
     if subject is not None:  # the tracker starts on the first view, taken at the gimbal's start pose
-        joint_yaw, _, pitch = SIM_CONFIG.initial_joint_deg
-        view_box = vc.box_to_view(first_box(seq), joint_yaw + SIM_CONFIG.base_yaw_deg, pitch)
+        joint_yaw, _, pitch = sim_config.initial_joint_deg
+        view_box = vc.box_to_view(first_box(seq), joint_yaw + sim_config.base_yaw_deg, pitch)
         if view_box is None:
             raise ValueError(f"{seq.name}: the first ground-truth box is behind the view")
         start_box(view_box, *settings.out_size)
-    return PreparedLoop(settings, seq, frames, first, vc, controller, subject)
+    return PreparedLoop(settings, seq, frames, first, vc, controller, subject, sim_config)
 
 
 def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> LoopResult:
@@ -200,7 +215,7 @@ def run_prepared(loop: PreparedLoop) -> LoopResult:
     settings, seq, frames, first, vc = loop.settings, loop.seq, loop.frames, loop.first, loop.vc
     subject = SimulatedSubject(OracleTracker(vc.camera.width, vc.camera.height), loop.subject)
 
-    host_bus, sim = start_in_process(SIM_CONFIG)
+    host_bus, sim = start_in_process(loop.sim_config)
     steps: list[LoopStep] = []
     try:
         with GimbalClient(host_bus) as client:
