@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from collections.abc import Iterator, Sequence as Seq
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import can
 import numpy as np
 
 from gimbal.client import GimbalClient
@@ -25,7 +26,7 @@ from gimbal.sim.model import GimbalModel
 from pipelines.control.controller import ControlConfig, Controller, RateCommand, make_controller
 from pipelines.control.gimbal_link import GimbalLink
 from pipelines.control.metrics import CentringSample, summarize
-from pipelines.loop import Loop
+from pipelines.loop import Loop, Sink
 from pipelines.sources import Frame
 from pipelines.virtual_camera import VirtualCamera
 from tracker import SubjectTracker, make_tracker
@@ -183,6 +184,7 @@ class PreparedLoop:
     controller: Controller
     subject: SubjectTracker | None  # None: the oracle
     sim_config: SimConfig  # the simulated gimbal, pointed at the first ground-truth box
+    samples: dict[int, CentringSample | None] = field(default_factory=dict)  # by frame index, as the run goes
 
 
 def prepare_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> PreparedLoop:
@@ -210,24 +212,28 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
     return run_prepared(prepare_loop(sequence, settings))
 
 
-def run_prepared(loop: PreparedLoop) -> LoopResult:
-    """Run a prepared loop; see the module doc."""
+def run_prepared(loop: PreparedLoop, sinks: Seq[Sink] = (), listeners: Seq[can.Listener] = ()) -> LoopResult:
+    """Run a prepared loop; see the module doc. ``sinks`` get every frame's record and view (and
+    are closed however the run ends), ``listeners`` every CAN frame both ways (e.g. a CAN log)."""
     settings, seq, frames, first, vc = loop.settings, loop.seq, loop.frames, loop.first, loop.vc
     subject = SimulatedSubject(OracleTracker(vc.camera.width, vc.camera.height), loop.subject)
 
     host_bus, sim = start_in_process(loop.sim_config)
     steps: list[LoopStep] = []
     try:
-        with GimbalClient(host_bus) as client:
+        with GimbalClient(host_bus, listeners=list(listeners)) as client:
             link = GimbalLink(client)
             link.start(wait_s=1.0)
             closed = Loop(subject, loop.controller, link)
+            for sink in sinks:
+                closed.attach(sink)
             pending: deque[_Captured] = deque()
             t0 = time.monotonic() + 0.05
             truth = iter(seq.groundtruth)
 
             def process(item: _Captured) -> None:
                 subject.truth, subject.index = item.box, item.index
+                loop.samples[item.index] = item.sample
                 record = closed.step(Frame(item.view, item.t, item.index), item.t)
                 steps.append(LoopStep(item.t - t0, item.sample, record.command))
 
@@ -252,5 +258,7 @@ def run_prepared(loop: PreparedLoop) -> LoopResult:
     finally:
         sim.stop()
         host_bus.shutdown()
+        for sink in sinks:
+            sink.close()
     used = replace(settings, tracker=subject.name, hfov_deg=vc.camera.hfov_deg)
     return LoopResult(used, steps, summarize([s.sample for s in steps]), latencies)
