@@ -33,6 +33,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from gimbal.errors import GimbalError
 from gimbal.sim import SimConfig
 from machine import describe_machine
 from pipelines.closed_loop import LoopSettings, run_closed_loop
@@ -151,8 +152,13 @@ def main(argv: list[str]) -> int:
         for latency in LATENCIES_MS:
             rms = {}
             for name in CONTROLLERS:
-                result = run_closed_loop(path, LoopSettings(controller=name, latency_s=latency / 1000,
-                                                            out_size=view_size(path), fps=args.fps))
+                try:
+                    result = run_closed_loop(path, LoopSettings(controller=name, latency_s=latency / 1000,
+                                                                out_size=view_size(path), fps=args.fps))
+                except GimbalError as exc:  # the simulator starved of CPU on a loaded machine
+                    print(f"{path.name:<20}{latency:>6} ms{name:>6}  failed: {exc}", flush=True)
+                    ok = False
+                    continue
                 s = result.summary
                 span = result.steps[-1].t - result.steps[0].t
                 kept = (len(result.steps) - 1) / span if span > 0 else math.nan
@@ -165,11 +171,14 @@ def main(argv: list[str]) -> int:
                       f"{kept:>10.1f}", flush=True)
                 if name == "pid":
                     ok &= s["out_of_view"] <= TARGET_OUT_OF_VIEW
-            ratio = rms["pid"] / rms["p"]
-            ok &= ratio <= TARGET_RATIO
-            print(f"{'':<20}{latency:>6} ms  RMS ratio pid/p = {ratio:.2f} (target <= {TARGET_RATIO})")
-    print(f"\nmeans over {len(sequences)} sequences at {args.fps:g} fps:")
+            if len(rms) == len(CONTROLLERS):
+                ratio = rms["pid"] / rms["p"]
+                ok &= ratio <= TARGET_RATIO
+                print(f"{'':<20}{latency:>6} ms  RMS ratio pid/p = {ratio:.2f} (target <= {TARGET_RATIO})")
+    print(f"\nmeans over the runs that finished ({len(sequences)} sequences) at {args.fps:g} fps:")
     for latency in LATENCIES_MS:
+        if any((latency, name) not in rms_all for name in CONTROLLERS):
+            continue
         p, pid = (statistics.fmean(rms_all[latency, name]) for name in CONTROLLERS)
         print(f"{latency:>6} ms  RMS p {p:.4f}, pid {pid:.4f} (ratio {pid / p:.2f}); out of view "
               f"p {statistics.fmean(out_all[latency, 'p']):.1%}, pid {statistics.fmean(out_all[latency, 'pid']):.1%}"
