@@ -51,6 +51,7 @@ class LoopSettings:
     fps: float = 30.0
     control: ControlConfig = ControlConfig()
     model_dir: Path | None = None  # the tracker's model files (e.g. NanoTrack's), as make_tracker takes them
+    max_frames: int | None = None  # stop after this many frames (None: the whole sequence)
 
 
 @dataclass(frozen=True)
@@ -252,7 +253,7 @@ def run_prepared(loop: PreparedLoop, sinks: Seq[Sink] = (), listeners: Seq[can.L
                 box, sample = _truth_in_view(vc, next(truth), yaw, pitch, t_cap - t0)
                 pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box, sample))
                 index += 1
-                frame = next(frames, None)
+                frame = next(frames, None) if settings.max_frames is None or index < settings.max_frames else None
             link.stop()
             latencies = link.latencies()
     finally:

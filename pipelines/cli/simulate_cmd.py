@@ -52,6 +52,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
                         "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: none)")
     parser.add_argument("--fps", type=float, default=30.0, help="playback frame rate (default 30)")
+    parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames (default: all)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
     parser.add_argument("--out", type=out_dir, metavar="DIR",
                         help="write the view's annotated video, telemetry, CAN log, plot.png and summary.json "
@@ -114,11 +115,13 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"--latency takes 0 to {MAX_LATENCY_MS:g} ms and --fps above 0 up to {MAX_FPS:g}")
     if args.fov is not None and not 0 < args.fov < 180:
         raise CliError(f"--fov takes 0 < DEG < 180, not {args.fov:g}")
+    if args.max_frames is not None and args.max_frames < 1:
+        raise CliError("--max-frames must be at least 1")
     if max(args.size) > MAX_SIDE:
         raise CliError(f"--size takes at most {MAX_SIDE} pixels a side, not {args.size[0]}x{args.size[1]}")
     settings = LoopSettings(controller=args.controller, tracker=args.tracker, hfov_deg=args.fov,
                             out_size=args.size, latency_s=args.latency / 1000.0, fps=args.fps,
-                            model_dir=args.model_dir)
+                            model_dir=args.model_dir, max_frames=args.max_frames)
     outputs = None
     try:
         loop = prepare_loop(args.sequence, settings)  # a bad sequence fails before --out is created
