@@ -53,7 +53,7 @@ from gimbal.transport import (
     is_packet_frame,
     with_default_bitrate,
 )
-from gimbal.values import integer, number
+from gimbal.values import integer, number, shown
 
 log = logging.getLogger(__name__)
 
@@ -76,9 +76,9 @@ def _checked_wait(timeout: float, retries: int) -> tuple[float, int]:
     """A reply timeout (s, above 0, at most ``MAX_TIMEOUT``) and retry count (an int, 0 or more) as
     float and int; ``ValueError`` naming what is wrong otherwise."""
     if not number(0, MAX_TIMEOUT, above=True)(timeout):
-        raise ValueError(f"timeout must be above 0 and at most {MAX_TIMEOUT:.0f} s, not {timeout!r}")
+        raise ValueError(f"timeout must be above 0 and at most {MAX_TIMEOUT:.0f} s, not {shown(timeout)}")
     if not integer(0)(retries):
-        raise ValueError(f"retries must be a whole number, 0 or more, not {retries!r}")
+        raise ValueError(f"retries must be a whole number, 0 or more, not {shown(retries)}")
     return float(timeout), int(retries)
 
 
@@ -436,7 +436,7 @@ class GimbalSession:
         once if it is closed or loses the bus meanwhile. ``timeout`` must be a number, 0 to
         ``MAX_TIMEOUT`` s (``ValueError``)."""
         if not number(0, MAX_TIMEOUT)(timeout):
-            raise ValueError(f"a push timeout must be 0 to {MAX_TIMEOUT:.0f} s, not {timeout!r}")
+            raise ValueError(f"a push timeout must be 0 to {MAX_TIMEOUT:.0f} s, not {shown(timeout)}")
         self._check_alive()
         return self.pushes.wait(cls, timeout)
 

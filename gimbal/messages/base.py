@@ -9,6 +9,7 @@ from numbers import Integral
 from typing import Any, ClassVar, Self, TypeVar
 
 from gimbal.errors import PayloadError, RangeError
+from gimbal.values import shown
 
 GIMBAL_CMD_SET = 0x0E
 CAMERA_CMD_SET = 0x0D
@@ -106,9 +107,9 @@ class Message:
                 raise RangeError(f"{self.NAME}.{name} is set but an earlier field is missing: "
                                  "only trailing fields may be left out")
             if value.__class__ is not int and (not isinstance(value, Integral) or isinstance(value, bool)):
-                raise RangeError(f"{self.NAME}.{name} must be an integer, not {value!r}")
+                raise RangeError(f"{self.NAME}.{name} must be an integer, not {shown(value)}")
             if not low <= value <= high:
-                raise RangeError(f"{self.NAME}.{name}={value} is outside {low}..{high}"
+                raise RangeError(f"{self.NAME}.{name}={shown(value)} is outside {low}..{high}"
                                  + self._in_units(name, value, low, high))
             if allowed is not None and value not in allowed:
                 listed = ", ".join(f"0x{v:02X}" for v in sorted(allowed))
@@ -119,7 +120,7 @@ class Message:
         if name not in self.UNITS:
             return ""
         step, unit = self.UNITS[name]
-        return f" ({value * step:g}{unit}: allowed {low * step:g}..{high * step:g}{unit})"
+        return f" ({shown(value * step)}{unit}: allowed {low * step:g}..{high * step:g}{unit})"
 
     def fields(self) -> dict[str, Any]:
         """The fields as JSON-friendly values (bytes as hex)."""

@@ -9,6 +9,7 @@ from typing import ClassVar, NamedTuple
 from gimbal.errors import RangeError
 from gimbal.messages.base import GIMBAL_CMD_SET, register
 from gimbal.messages.kinds import Command, Reply, ReturnCodeReply
+from gimbal.values import shown
 from gimbal.messages.limits import (ANGLE_RANGES, PITCH_ANGLE_RANGE, ROLL_ANGLE_RANGE, SPEED_RANGE,
                                     TENTHS, TIME_RANGE, YAW_ANGLE_RANGE)
 DECI_DEGREE = (0.1, "°")
@@ -36,15 +37,19 @@ POSITION_INVALID = {"yaw": POSITION_YAW_INVALID, "roll": POSITION_ROLL_INVALID,
 def finite_number(value: float, name: str) -> float:
     """``value`` as a float: any real number but a bool (numpy's too); ``RangeError`` otherwise."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise RangeError(f"{name}={value!r} is not a number")
+        raise RangeError(f"{name}={shown(value)} is not a number")
     if not math.isfinite(value):
-        raise RangeError(f"{name}={value!r} is not a finite number")
+        raise RangeError(f"{name}={shown(value)} is not a finite number")
     return float(value)
 
 
 def to_raw(value: float, name: str) -> int:
-    """Degrees (or °/s, or s) to the wire's 0.1 units, rounded to the nearest unit."""
-    return round(finite_number(value, name) * TENTHS)
+    """Degrees (or °/s, or s) to the wire's 0.1 units, rounded to the nearest unit; a number too
+    large for them (1e308 × 10 is infinite) is a ``RangeError`` like any other out of range."""
+    scaled = finite_number(value, name) * TENTHS
+    if not math.isfinite(scaled):
+        raise RangeError(f"{name}={shown(value)} is outside any range the document gives")
+    return round(scaled)
 
 
 def from_raw(raw: int) -> float:

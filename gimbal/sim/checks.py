@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from numbers import Integral, Real
 
-from gimbal.values import Test, is_flag
+from gimbal.values import Test, is_flag, shown
 
 
 class FieldError(ValueError):
@@ -12,7 +12,7 @@ class FieldError(ValueError):
     where a front end may use another), not ``value``."""
 
     def __init__(self, owner: str, field: str, takes: str, value: object) -> None:
-        super().__init__(f"{owner}.{field} takes {takes}, not {value!r}")
+        super().__init__(f"{owner}.{field} takes {takes}, not {shown(value)}")
         self.owner, self.field, self.takes, self.value = owner, field, takes, value
 
     @property

@@ -103,9 +103,10 @@ def parse_bitrate(text: str) -> int:
 
 
 def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | None = None,
-                    repeated: bool = False, offers_sim: bool = True) -> None:
+                    repeated: bool = False, offers_sim: bool = True, fallback: str | None = None) -> None:
     """python-can's own options; unset values fall back to can.rc, CAN_* variables and ~/.canrc.
-    ``offers_sim``: ``-i sim`` (the built-in simulated gimbal) is one of the choices.
+    ``offers_sim``: ``-i sim`` (the built-in simulated gimbal) is one of the choices; ``fallback``:
+    what the command uses when python-can's configuration names no interface.
 
     ``repeated`` adds them again to a command whose parent parser has them already: given there
     they win, left out they keep the parent's value (``gimbal -i sim angles`` = ``gimbal angles -i sim``).
@@ -116,7 +117,7 @@ def add_bus_options(parser: argparse.ArgumentParser, default_interface: str | No
         help="python-can interface (socketcan, slcan, pcan, kvaser, gs_usb, virtual, udp_multicast, ...)"
         + (" or 'sim' for the built-in simulated gimbal" if offers_sim else "")
         + (f" (default: {default_interface})" if default_interface else
-           " (default: python-can's configuration)"),
+           " (default: python-can's configuration" + (f", else {fallback})" if fallback else ")")),
     )
     group.add_argument("-c", "--channel", help="channel, e.g. can0, /dev/ttyACM0, PCAN_USBBUS1, a multicast "
                        "group (not with the simulated gimbal)")

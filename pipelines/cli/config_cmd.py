@@ -8,6 +8,7 @@ from typing import Any
 
 import can
 
+from pipelines.cli.bus import SIM_INTERFACE
 from pipelines.cli.common import CliError
 from pipelines.cli.profile import SCHEMA, Key, Profile, profile_path, read_profile
 
@@ -58,6 +59,8 @@ def effective_settings(defaults: dict[str, Any], profile: Profile | None) -> lis
                 value, source = can_config[name], "python-can configuration"
             else:
                 value, source = _as_key(defaults.get(key.dest), key), "default"
+                if label == "[bus].interface" and value is None:  # track's own fallback (bus.choose_track_bus)
+                    value = SIM_INTERFACE
             rows.append((label, value, source))
     return rows
 

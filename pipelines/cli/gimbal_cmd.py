@@ -24,8 +24,8 @@ from gimbal.messages.camera import CameraAction, CameraActionCode, CameraStatusQ
 from gimbal.messages.external import (FOCUS_CALIBRATION_STATES, DialPush, FocusCalibration,
                                       FocusPositionControl, FocusPositionQuery, JoystickPush)
 from gimbal.messages.limits import (ANGLE_RANGES, DIAL_RANGE, FOCUS_POSITION_RANGE, JOYSTICK_RANGE,
-                                    LIMIT_RANGES, MAX_SPEED_DPS, STIFFNESS_RANGES, TIME_RANGE)
-from gimbal.messages.motion import AXES, GetAngles, from_raw
+                                    LIMIT_RANGES, MAX_SPEED_DPS, SPEED_RANGE, STIFFNESS_RANGES, TIME_RANGE)
+from gimbal.messages.motion import AXES, GetAngles, PositionControl, SpeedControl, from_raw, to_raw
 from gimbal.messages.settings import (ActiveTrack, GetAngleLimits, GetMotorStiffness,
                                       RecenterSelfie, SetAngleLimits, SetFollowMode,
                                       SetMotorStiffness, SetWorkMode, SELFIE)
@@ -36,6 +36,7 @@ from gimbal.messages.tlv_params import (CALIBRATION_STATES, ROLL360_MODES, AutoC
                                         describe_user_param, motors_off, param_table, roll360_mode)
 from gimbal.packet import REPLY_OPTIONAL, encode_packet
 from gimbal.session import MAX_TIMEOUT
+from gimbal.values import shown
 from pipelines.cli.bus import open_host_bus
 from pipelines.cli.common import (CliError, add_bus_options, parse_int, parse_seconds,
                                   suppress_defaults)
@@ -115,7 +116,7 @@ def describe_push(message: Message, t: float) -> Result:
         if message.joint is not None:
             out["joint"] = message.joint._asdict()
         if message.limits_valid:
-            out["limits"] = {n: getattr(message, n) for n in LIMITS}
+            out["limits"] = signed_limits({n: getattr(message, n) for n in LIMITS})
         if message.stiffness_valid:
             out["stiffness"] = {a: getattr(message, f"{a}_stiffness") for a in STIFFNESS}
     elif isinstance(message, CalibrationStatusPush):
@@ -166,10 +167,30 @@ def _move_args(p: argparse.ArgumentParser) -> None:
                    help=f"seconds to get there, {_span(TIME_RANGE, from_raw)} (default 2)")
 
 
+def _check_field(option: str, value: float, message: type[Message], field: str, raw_range: tuple[int, int]) -> None:
+    """``CliError`` naming ``--option`` unless ``value`` (degrees, °/s or s) fits ``field`` of the
+    document's ``message``; a number too large for the wire at all (1e308) is told in the
+    document's units."""
+    step, unit = message.UNITS[field]
+    try:
+        raw = to_raw(value, option)
+    except RangeError:
+        low, high = raw_range
+        raise CliError(f"--{option} {shown(value)} is outside the document's {low * step:g}..{high * step:g}"
+                       f"{unit}") from None
+    try:
+        message(**{field: raw}).validate()
+    except RangeError as exc:
+        raise CliError(f"--{option}: {exc}") from None
+
+
 def _move_message(args: argparse.Namespace) -> list[Message]:
     axes = [a for a in AXES if getattr(args, a) is not None]
     if not axes:
         raise CliError("give at least one of --yaw, --roll, --pitch")
+    for axis in axes:
+        _check_field(axis, getattr(args, axis), PositionControl, f"{axis}_angle", ANGLE_RANGES[axis])
+    _check_field("time", args.time, PositionControl, "time_for_action", TIME_RANGE)
     return [position_message(args.yaw or 0.0, args.roll or 0.0, args.pitch or 0.0,
                              absolute=args.absolute, time_s=args.time, axes=axes)]
 
@@ -180,6 +201,12 @@ def _move(client: GimbalClient, args: argparse.Namespace) -> Result:
                     absolute=args.absolute, time_s=args.time, axes=axes)
     return {"moving": {a: getattr(args, a) for a in axes}, "absolute": args.absolute,
             "time_s": args.time}
+
+
+def _speed_messages(args: argparse.Namespace) -> list[Message]:
+    for axis in ("yaw", "pitch", "roll"):
+        _check_field(axis, getattr(args, axis), SpeedControl, f"{axis}_speed", SPEED_RANGE)
+    return [speed_message(args.yaw, args.pitch, args.roll)]
 
 
 def _speed_args(p: argparse.ArgumentParser) -> None:
@@ -213,24 +240,47 @@ def _speed(client: GimbalClient, args: argparse.Namespace) -> Result:
     return {"duration_s": args.duration, **{k: stats[k] for k in counts}}
 
 
+def _limit_degrees(name: str) -> tuple[int, int]:
+    """A limit's range in signed degrees: the document's min limits (pitch_min 0..55) say how far
+    below zero the limit lies, so the user's -55..0 (and the wire's 55..0)."""
+    high = LIMIT_RANGES[name][1]
+    return (-high, 0) if name.endswith("_min") else (0, high)
+
+
+def signed_limits(values: dict[str, int | None]) -> dict[str, int | None]:
+    """Limits as the document encodes them -> signed degrees (pitch_min 55 -> -55)."""
+    return {n: -v if n.endswith("_min") and v else v for n, v in values.items()}
+
+
+def _limits_given(args: argparse.Namespace) -> dict[str, int]:
+    """The limits given, in signed degrees, checked and encoded as the document wants them."""
+    given = {}
+    for name, value in _given(args, LIMITS).items():
+        low, high = _limit_degrees(name)
+        if not low <= value <= high:
+            raise CliError(f"--{name.replace('_', '-')} {shown(value)} is outside the document's {low}..{high}°"
+                           + (" (a limit below zero)" if low < 0 else ""))
+        given[name] = abs(value)
+    return given
+
+
 def _limits_args(p: argparse.ArgumentParser) -> None:
     for name in LIMITS:
+        low, high = _limit_degrees(name)
         p.add_argument("--" + name.replace("_", "-"), type=int, dest=name,
-                       help=f"whole degrees 0..{LIMIT_RANGES[name][1]}"
-                       + (" (below zero)" if name.endswith("min") else ""))
+                       help=f"whole degrees {low}..{high}" + (" (below zero)" if low < 0 else ""))
 
 
 def _limits_messages(args: argparse.Namespace) -> list[Message]:
+    given = _limits_given(args)
     _for_print(args, LIMITS, "limits")
-    given = _given(args, LIMITS)
     return [SetAngleLimits(1, **given)] if given else [GetAngleLimits()]
 
 
-def _read_or_update(args: argparse.Namespace, names: tuple[str, ...], field: str,
+def _read_or_update(given: dict[str, int], names: tuple[str, ...], field: str,
                     read: Callable[[], Message], write: Callable[..., None]) -> dict[str, int]:
-    """All values read; or the given ones written, the others first read back and kept.
+    """All values read; or the ``given`` ones written, the others first read back and kept.
     ``field`` turns a name into the reply's field name."""
-    given = _given(args, names)
     if given:
         current = read() if len(given) < len(names) else None
         values = {n: given.get(n, getattr(current, field.format(n), None)) for n in names}
@@ -241,8 +291,8 @@ def _read_or_update(args: argparse.Namespace, names: tuple[str, ...], field: str
 
 
 def _limits(client: GimbalClient, args: argparse.Namespace) -> Result:
-    return {"limits": _read_or_update(args, LIMITS, "{}", client.get_angle_limits,
-                                      client.set_angle_limits)}
+    return {"limits": signed_limits(_read_or_update(_limits_given(args), LIMITS, "{}", client.get_angle_limits,
+                                                    client.set_angle_limits))}
 
 
 def _stiffness_args(p: argparse.ArgumentParser) -> None:
@@ -260,7 +310,7 @@ def _stiffness_messages(args: argparse.Namespace) -> list[Message]:
 
 
 def _stiffness(client: GimbalClient, args: argparse.Namespace) -> Result:
-    return {"stiffness": _read_or_update(args, STIFFNESS, "{}_stiffness", client.get_stiffness,
+    return {"stiffness": _read_or_update(_given(args, STIFFNESS), STIFFNESS, "{}_stiffness", client.get_stiffness,
                                          client.set_stiffness)}
 
 
@@ -447,8 +497,8 @@ COMMANDS = [
             lambda c, a: {k: _angles(c, k) for k in _kinds(a)}, _angles_args),
     Command("move", "position control: go to (or by) angles in degrees", _move_message, _move,
             _move_args),
-    Command("speed", "turn at °/s for --duration, kept alive, then stop and release", lambda a: [
-        speed_message(a.yaw, a.pitch, a.roll)], _speed, _speed_args),
+    Command("speed", "turn at °/s for --duration, kept alive, then stop and release", _speed_messages, _speed,
+            _speed_args),
     Command("limits", "read the angle limits, or set them (unset ones are kept)", _limits_messages,
             _limits, _limits_args),
     Command("stiffness", "read motor stiffness, or set it (unset axes are kept)",
@@ -549,7 +599,7 @@ def run(command: Command, args: argparse.Namespace) -> int:
             message.validate()
         if args.print_packet:
             if not 0 <= args.seq <= 0xFFFF:
-                raise CliError(f"--seq must be 0..0xFFFF (SEQ is 2 bytes), not {args.seq:#x}")
+                raise CliError(f"--seq must be 0..0xFFFF (SEQ is 2 bytes), not {shown(args.seq)}")
             for offset, message in enumerate(messages):
                 packet = message_packet(message, (args.seq + offset) & 0xFFFF,
                                         command.cmd_types.get(type(message)))

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from collections import Counter
@@ -21,16 +20,18 @@ from gimbal.log_decode import HOST_TO_GIMBAL, LogDecoder, Record
 from gimbal.messages import message_packet
 from gimbal.messages.motion import SPEED_TAKE_CONTROL, from_raw
 from gimbal.transport import CanTransport, packet_frames
+from gimbal.values import shown
 from pipelines.cli.bus import SIM_INTERFACE, open_host_bus, simulated_gimbal
 from pipelines.cli.common import CliError, add_bus_options
 from pipelines.cli.firmware_opts import add_legacy_order_option
-from pipelines.cli.decode_cmd import _close, _open_log, check_log_path, iter_log_frames
+from pipelines.cli.log_input import LogFrames, check_log_path, close_reader, open_log
 from pipelines.cli.sim_cmd import status_line
 
 ARROWS = {HOST_TO_GIMBAL: "host->gimbal", None: "?"}
 PUSH_KEY_FIELDS = ("yaw_angle", "roll_angle", "pitch_angle")  # a push's other fields rarely change
 STOP_SEQ = 0xFFF0  # SEQs of the safety stop sent after an interrupted replay
-SETTLE_S = 1.0  # how long the simulated gimbal may take to come to rest before its state is shown
+SETTLE_S = 1.0
+SPEED_RANGE = (0.1, 100.0)  # playback factors: a 10-minute log takes 100 min to 6 s  # how long the simulated gimbal may take to come to rest before its state is shown
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -42,7 +43,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "bus at their recorded times ('-i sim': the built-in simulated gimbal, whose final state is "
         "printed); only whole packets of the document with every value in its range are sent, the "
         "others are counted in the summary. An interrupted replay onto a bus ends with zero speed "
-        "and control released.",
+        "and control released. A log whose last line is cut short (a recorder stopped mid-write) is "
+        "replayed up to it, with a warning; one unreadable part way is summarised up to there, then "
+        "the error (exit 2).",
         epilog="examples:\n  gimbaltrack replay out/track/can.log\n"
         "  gimbaltrack replay out/track/can.log --json | jq .\n"
         "  gimbaltrack replay out/track/can.log -i sim --speed 4\n"
@@ -54,7 +57,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--realtime", action="store_true",
                         help="print at the recorded pace (always on when sending onto a bus)")
     parser.add_argument("--speed", type=float, default=1.0, metavar="X",
-                        help="playback speed factor for --realtime and bus output (default 1)")
+                        help=f"playback speed factor for --realtime and bus output, {SPEED_RANGE[0]:g} to "
+                        f"{SPEED_RANGE[1]:g} (default 1)")
     add_bus_options(parser)
     add_legacy_order_option(parser)
     parser.set_defaults(func=run)
@@ -215,18 +219,22 @@ def _target(args: argparse.Namespace) -> Iterator[tuple[can.BusABC | None, Any]]
 
 def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
     out = out or sys.stdout
-    if not 0 < args.speed < math.inf:
-        raise CliError(f"--speed takes a finite factor above 0, not {args.speed:g}")
+    low, high = SPEED_RANGE
+    if not low <= args.speed <= high:
+        raise CliError(f"--speed takes a finite factor from {low:g} to {high:g}, not {shown(args.speed)}")
     if args.interface is None and (args.channel is not None or args.bitrate is not None):
         raise CliError("-c/--channel and -b/--bitrate need -i/--interface: replay sends onto a bus only with -i")
     check_log_path(args.log)  # before a bus is opened
     summary = ReplaySummary()
+    failure = None
     with _target(args) as (bus, sim):
         started = time.monotonic()
         completed = False
         try:
             _replay(args, summary, bus, out)
             completed = True
+        except CliError as exc:  # a log unreadable part way, a bus refusing: what was replayed is summarised first
+            failure = exc
         finally:
             if bus is not None and summary.frames_sent and (not completed or summary.holds_control):
                 _stop_gimbal(bus, args.tx_id, args.rx_id)
@@ -235,6 +243,8 @@ def run(args: argparse.Namespace, out: TextIO | None = None) -> int:
             _print(out, args.json, {"sim_state": state.as_dict()},
                    "simulated gimbal at the end: " + status_line(state, time.monotonic() - started))
         _print(out, args.json, {"summary": summary.as_dict()}, summary.text())
+    if failure is not None:
+        raise failure
     return 0
 
 
@@ -252,7 +262,7 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
     decoder = LogDecoder(args.tx_id, args.rx_id, args.legacy_order)
     pacer = _Pacer(args.speed) if args.realtime or bus is not None else None
     skip_echoes = _marks_sent_frames(args.log, args.tx_id)
-    with closing(iter_log_frames(args.log, "replay")) as frames:
+    with closing(LogFrames(args.log, "replay")) as frames:
         for frame in frames:
             if skip_echoes and frame.arbitration_id == args.tx_id and frame.is_rx:
                 summary.echoes += 1
@@ -270,18 +280,19 @@ def _replay(args: argparse.Namespace, summary: ReplaySummary, bus: can.BusABC | 
     if bus is not None:  # a host packet left incomplete is counted, never sent
         _send_host_packets(records, bus, args.tx_id, summary)
     _emit(records, summary, args.json, out)
+    frames.check()
 
 
 def _marks_sent_frames(path: str, tx_id: int) -> bool:
     """True when the log marks the host's frames as sent (``T``): then host-id frames marked
     received are the bus's echo of them (udp_multicast loops every frame back) and are skipped."""
-    reader = _open_log(path)
+    reader, _ = open_log(path)
     try:
         return any(f.arbitration_id == tx_id and not f.is_rx for f in reader)
     except Exception:  # noqa: BLE001 - an unreadable log is reported by the replay itself
         return False
     finally:
-        _close(reader)
+        close_reader(reader)
 
 
 def _send(bus: can.BusABC, raw: bytes, tx_id: int) -> int:

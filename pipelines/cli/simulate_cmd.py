@@ -2,10 +2,14 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
+from collections.abc import Iterator
 from pathlib import Path
+
+import numpy as np
 
 from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, PreparedLoop, prepare_loop, run_prepared
 from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
@@ -13,6 +17,7 @@ from pipelines.control.controller import controller_names
 from pipelines.control.metrics import MAX_ERROR, OVERSHOOT_WINDOW_S
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
+from pipelines.progress import ProgressReporter
 from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers
 
 
@@ -54,6 +59,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--fps", type=float, default=30.0, help="playback frame rate (default 30)")
     parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames (default: all)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+    parser.add_argument("--quiet", action="store_true", help="no progress line (shown on a terminal only)")
     parser.add_argument("--out", type=out_dir, metavar="DIR",
                         help="write the view's annotated video, telemetry, CAN log, plot.png and summary.json "
                         "here, as track does (default: none, nothing is written)")
@@ -68,6 +74,29 @@ def _size(text: str) -> tuple[int, int]:
     if w <= 0 or h <= 0:
         raise argparse.ArgumentTypeError(f"size must be positive, got {text!r}")
     return w, h
+
+
+class _CountedFrames:
+    """A prepared loop's frames, counted on a progress line as the run takes them, as ``track``
+    shows its own (the loop runs in real time: a long sequence takes minutes)."""
+
+    def __init__(self, frames: Iterator[np.ndarray], progress: ProgressReporter) -> None:
+        self._frames = frames
+        self._progress = progress
+        self.taken = 1  # prepare_loop read the first
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        return self
+
+    def __next__(self) -> np.ndarray:
+        self._progress.update(self.taken)
+        frame = next(self._frames)
+        self.taken += 1
+        return frame
+
+    def close(self, status: str) -> None:
+        self._progress.update(self.taken, status, force=True)
+        self._progress.close()
 
 
 def summary_of(result: LoopResult) -> dict[str, object]:
@@ -127,10 +156,16 @@ def run(args: argparse.Namespace) -> int:
         loop = prepare_loop(args.sequence, settings)  # a bad sequence fails before --out is created
         if args.out:
             make_out_dir(args.out)
-            outputs = Outputs(args.out, loop)
+            outputs = Outputs(args.out, loop)  # shares the loop's samples, as the copy below does
+        frames = _CountedFrames(loop.frames, ProgressReporter(len(loop.seq),
+                                                              enabled=not args.quiet and sys.stderr.isatty()))
+        status = "stopped"
         try:
-            result = run_prepared(loop, outputs.sinks if outputs else (), [outputs.can_log] if outputs else ())
+            result = run_prepared(dataclasses.replace(loop, frames=frames), outputs.sinks if outputs else (),
+                                  [outputs.can_log] if outputs else ())
+            status = "done"
         finally:
+            frames.close(status)
             if outputs:
                 outputs.stop()
         summary = summary_of(result)

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from contextlib import ExitStack
 from pathlib import Path
@@ -13,8 +12,9 @@ from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit, deferred_signals
+from gimbal.values import shown
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
-from pipelines.cli.bus import SIM_INTERFACE, open_host_bus
+from pipelines.cli.bus import choose_track_bus, open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.control import ControlConfig, controller_names
@@ -26,14 +26,17 @@ from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
 
 DEFAULT_DETECTOR = "motion"
+FPS_RANGE = (0.1, 1000.0)  # a frame every 10 s to 1000 a second; the video writer takes these
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "track", help="track a subject in video and keep it framed with the gimbal",
         description="Track a subject in a video file, image folder, camera or stream, turn its "
-        "position into yaw/pitch rates (Kalman + PID) and stream them to the gimbal. With no bus "
-        "options the built-in simulated gimbal is used. Outputs (annotated video, telemetry, CAN "
+        "position into yaw/pitch rates (Kalman + PID) and stream them to the gimbal. With no -i, "
+        "python-can's configuration (CAN_INTERFACE, CAN_CHANNEL, CAN_BITRATE, CAN_CONFIG, ~/.canrc) "
+        "picks the bus when it names an interface, else the built-in simulated gimbal is used; a "
+        "line on stderr says which. Outputs (annotated video, telemetry, CAN "
         "log, summary, plot) are written to --out as the run goes.",
         epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
         "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
@@ -86,7 +89,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run = parser.add_argument_group("run")
     run.add_argument("--realtime", action="store_true", help="play files at their own frame rate")
     run.add_argument("--fps", type=float, help="frame rate of an image folder (default: 30), or a video file's "
-                     "rate overriding its own")
+                     f"rate overriding its own; {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}")
     run.add_argument("--record", action="store_true",
                      help="start camera recording when the subject is acquired, stop it at the end")
     run.add_argument("--max-frames", type=int, help="stop after this many frames")
@@ -95,9 +98,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--video-width", type=int, default=DEFAULT_VIDEO_WIDTH, metavar="PX",
                      help=f"shrink the annotated video to at most this width (default: {DEFAULT_VIDEO_WIDTH}, "
                      "cheap to encode; 0: the source's full size)")
-    run.add_argument("--quiet", action="store_true", help="no progress line")
+    run.add_argument("--quiet", action="store_true", help="no progress line, and no line naming the bus "
+                     "chosen without -i (the summary names it)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
-    add_bus_options(parser, default_interface="sim")
+    add_bus_options(parser, fallback="the built-in simulated gimbal")
     add_legacy_order_option(parser)
     parser.set_defaults(func=run_track)
 
@@ -114,8 +118,8 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError(f"--max-speed takes 0 < DEG_S <= {PROTOCOL_MAX_SPEED_DPS:g} (the protocol's limit)")
     if args.video_width < 0 or args.video_width == 1:
         raise CliError("--video-width takes 0 (full size) or at least 2 pixels")
-    if args.fps is not None and not 0 < args.fps < math.inf:
-        raise CliError(f"--fps takes a finite frame rate above 0, not {args.fps:g}")
+    if args.fps is not None and not FPS_RANGE[0] <= args.fps <= FPS_RANGE[1]:
+        raise CliError(f"--fps takes {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} frames a second, not {shown(args.fps)}")
     if args.hfov is not None and not 0 < args.hfov < 180:
         raise CliError(f"--hfov takes 0 < DEG < 180, not {args.hfov:g}")
     if args.max_frames is not None and args.max_frames < 1:
@@ -142,7 +146,8 @@ def run_track(args: argparse.Namespace) -> int:
 
 def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
     try:
-        source = open_source(args.source, realtime=args.realtime, fps=args.fps)
+        source = open_source(args.source, realtime=args.realtime, fps=args.fps,
+                             waiting=None if args.quiet else _say_waiting)
     except SourceError as exc:
         raise CliError(str(exc)) from None
     with source:
@@ -157,6 +162,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             subject = make_subject(options)  # missing model files fail before --out is created
         except (ValueError, OSError) as exc:
             raise CliError(str(exc)) from None
+        where, chosen = choose_track_bus(args)
         with open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
@@ -166,17 +172,21 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             try:
                 with GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id, listeners=[can_log],
                                   legacy_attitude_order=args.legacy_order) as client:
-                    where = ("built-in simulated gimbal" if args.interface == SIM_INTERFACE else
-                             " ".join(str(v) for v in (args.interface or "python-can's configured bus",
-                                                       args.channel) if v))
                     try:
                         session = _session(options, source, client, where, subject, can_log, held)
                     except CliError:  # it says why the run ended; a signal held meanwhile adds nothing
                         pending_signals.clear()
                         raise
+                    if chosen and not args.quiet:  # once the gimbal answered: an error before names the bus
+                        print(chosen, file=sys.stderr, flush=True)
                     return _run(session, args)
             finally:
                 can_log.stop()
+
+
+def _say_waiting(description: str) -> None:
+    print(f"gimbaltrack track: waiting for {description}: nothing received yet (Ctrl-C stops)",
+          file=sys.stderr, flush=True)
 
 
 def _can_log(path: Path) -> CanLogWriter:

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import Protocol
 
 import cv2
@@ -14,6 +15,12 @@ from pipelines.sources.base import Frame, FrameSource, SourceError, nominal_fps
 DEFAULT_STALL_TIMEOUT = 2.0
 DEFAULT_OPEN_TIMEOUT = 10.0
 MAX_CAMERA_INDEX = 100
+#: A live source silent this long while it opens gets a note: opening and the first frame may
+#: take up to ``open_timeout`` each, 10 to 20 s of a silent terminal.
+WAIT_NOTICE_S = 2.0
+
+#: Told a live source's description once it has been silent for ``WAIT_NOTICE_S`` while opening.
+Waiting = Callable[[str], None]
 
 
 class Capture(Protocol):
@@ -190,27 +197,44 @@ def open_interruptibly(open_capture: Callable[[], cv2.VideoCapture]) -> cv2.Vide
     return opening.wait()
 
 
+@contextmanager
+def _told_while_silent(description: str, waiting: Waiting | None) -> Iterator[None]:
+    """Call ``waiting(description)`` once if the block is still running after ``WAIT_NOTICE_S``."""
+    if waiting is None:
+        yield
+        return
+    timer = threading.Timer(WAIT_NOTICE_S, waiting, args=(description,))
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+
+
 def open_camera(index: int, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
-                open_timeout: float = DEFAULT_OPEN_TIMEOUT) -> LiveSource:
+                open_timeout: float = DEFAULT_OPEN_TIMEOUT, waiting: Waiting | None = None) -> LiveSource:
     """Camera number ``index`` (0 to 99) through OpenCV's default backend."""
     if not 0 <= index < MAX_CAMERA_INDEX:  # OpenCV reads the hundreds of an index as a backend's number
         raise SourceError(f"camera index {index} is out of range (0 to {MAX_CAMERA_INDEX - 1})")
-    capture = open_interruptibly(lambda: cv2.VideoCapture(index))
-    if not capture.isOpened():
-        raise SourceError(f"camera {index} does not open (not connected, busy or no permission)")
-    return LiveSource(capture, f"camera {index}", nominal_fps(capture), stall_timeout, open_timeout)
+    with _told_while_silent(f"camera {index}", waiting):
+        capture = open_interruptibly(lambda: cv2.VideoCapture(index))
+        if not capture.isOpened():
+            raise SourceError(f"camera {index} does not open (not connected, busy or no permission)")
+        return LiveSource(capture, f"camera {index}", nominal_fps(capture), stall_timeout, open_timeout)
 
 
 def open_stream(url: str, stall_timeout: float = DEFAULT_STALL_TIMEOUT,
-                open_timeout: float = DEFAULT_OPEN_TIMEOUT) -> LiveSource:
+                open_timeout: float = DEFAULT_OPEN_TIMEOUT, waiting: Waiting | None = None) -> LiveSource:
     """A network stream read by OpenCV's FFmpeg backend (udp://, rtsp://, http(s)://, ...)."""
     params = [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, int(open_timeout * 1000),
               cv2.CAP_PROP_READ_TIMEOUT_MSEC, int(stall_timeout * 1000)]
     started = time.monotonic()
-    capture = open_interruptibly(lambda: cv2.VideoCapture(url, cv2.CAP_FFMPEG, params))
-    if not capture.isOpened():
-        if time.monotonic() - started >= open_timeout:
-            raise SourceError(f"cannot open stream {url}: nothing received within {open_timeout:g} s")
-        raise SourceError(f"cannot open stream {url} (connection refused, not found, or not a stream "
-                          "FFmpeg can read)")
-    return LiveSource(capture, url, nominal_fps(capture), stall_timeout, open_timeout)
+    with _told_while_silent(url, waiting):
+        capture = open_interruptibly(lambda: cv2.VideoCapture(url, cv2.CAP_FFMPEG, params))
+        if not capture.isOpened():
+            if time.monotonic() - started >= open_timeout:
+                raise SourceError(f"cannot open stream {url}: nothing received within {open_timeout:g} s")
+            raise SourceError(f"cannot open stream {url} (connection refused, not found, or not a stream "
+                              "FFmpeg can read)")
+        return LiveSource(capture, url, nominal_fps(capture), stall_timeout, open_timeout)

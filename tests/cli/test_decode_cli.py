@@ -126,7 +126,7 @@ def test_log_of_garbage_exits_0(tmp_path: Path, capsys: pytest.CaptureFixture[st
 def test_a_log_without_frames_is_a_note_and_exit_0(command: str, tmp_path: Path,
                                                    capsys: pytest.CaptureFixture[str],
                                                    monkeypatch: pytest.MonkeyPatch) -> None:
-    """decode and replay read logs through the same iter_log_frames."""
+    """decode and replay read logs through the same LogFrames."""
     monkeypatch.setattr(pipelines.cli.app, "SUBCOMMAND_MODULES", [f"pipelines.cli.{command}_cmd"])
     path = tmp_path / "empty.log"
     path.write_text("")

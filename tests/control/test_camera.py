@@ -3,7 +3,7 @@ import math
 import pytest
 from hypothesis import given, strategies as st
 
-from pipelines.control.camera import DEFAULT_HFOV_DEG, CameraModel
+from pipelines.control.camera import CameraModel, DEFAULT_HFOV_DEG
 
 
 def test_default_hfov_is_24mm_on_full_frame():
@@ -50,3 +50,10 @@ def test_round_trip(x, y, hfov):
 def test_directions_behind_the_camera_are_rejected():
     with pytest.raises(ValueError):
         CameraModel(640, 360).angles_to_pixel(95.0, 0.0)
+
+
+# Directions the pinhole model cannot map to a pixel.
+@pytest.mark.parametrize("yaw, pitch", [(90.0, 0.0), (-95.0, 0.0), (0.0, 90.0), (0.0, -95.0), (10.0, -120.0)])
+def test_directions_at_or_beyond_90_deg_on_either_axis_are_rejected(yaw: float, pitch: float) -> None:
+    with pytest.raises(ValueError, match="not in front of the camera"):
+        CameraModel(640, 360).angles_to_pixel(yaw, pitch)

@@ -1,4 +1,6 @@
 """The rate controllers in a synthetic closed loop (tests/control/control_scene.py)."""
+from __future__ import annotations
+
 import dataclasses
 import math
 
@@ -6,12 +8,14 @@ import numpy as np
 import pytest
 
 from control_scene import run_scene
-from pipelines.control.direction import relative
 from pipelines.control.camera import CameraModel
 from pipelines.control.controller import (
     ControlConfig, ProportionalController, RateController, controller_names, make_controller,
 )
+from pipelines.control.direction import Direction, DirectionFilter, relative, wrap_deg
+from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate
 from tracker.estimate import TargetEstimate, TrackState
+
 
 CAM = CameraModel(640, 360)
 KEEPALIVE_MAX_AGE_S = 0.3  # the speed streamer sends zero instead of a setpoint this old
@@ -388,3 +392,149 @@ def test_a_nan_box_is_never_steered_by(name):
         cmds.append(ctl.update(TargetEstimate(box, (0, 0), 0.9, TrackState.TRACKING, t, i), (0.0, 0.0), t))
     rates = np.array([(c.yaw_dps, c.pitch_dps) for c in cmds])
     assert np.isfinite(rates).all() and np.abs(rates).max() < 1.0
+
+
+# What the P baseline's setpoints report besides the speeds: signed errors and latency.
+
+
+def test_errors_follow_the_cameras_angle_convention_and_latency_is_now_minus_capture() -> None:
+    """A target up and to the right: yaw and pitch errors are the camera's angles of its centre
+    (both positive), and the latency is the time since the frame's capture."""
+    controller = ProportionalController(CAM)
+    box = (390.0, 90.0, 20.0, 20.0)  # centre (400, 100): right of and above (320, 180)
+    controller.update(TargetEstimate(box, (0.0, 0.0), 0.9, TrackState.TRACKING, 0.0, 0), None, 0.01)
+    command = controller.update(TargetEstimate(box, (0.0, 0.0), 0.9, TrackState.TRACKING, 1 / 30, 1), None, 0.05)
+    assert (command.yaw_error_deg, command.pitch_error_deg) == pytest.approx(CAM.pixel_to_angles(400.0, 100.0))
+    assert command.pitch_error_deg > 0.0 and command.yaw_error_deg > 0.0
+    assert command.yaw_dps > 0.0 and command.pitch_dps > 0.0
+    assert command.latency_s == pytest.approx(0.05 - 1 / 30)
+    assert command.stamp == pytest.approx(1 / 30)
+
+
+# The PID's integral share of a setpoint is capped by ``integral_limit_dps``.
+
+
+def test_a_gimbal_held_at_its_stop_does_not_wind_the_integral_past_its_limit() -> None:
+    """The subject stays 3 deg right of a gimbal that cannot move: the error never closes, and the
+    setpoint grows by the integral only up to ``integral_limit_dps`` over the proportional part."""
+    cfg = ControlConfig(ki=4.0, integral_limit_dps=5.0)
+    controller = RateController(CAM, cfg)
+    x, _ = CAM.angles_to_pixel(3.0, 0.0)
+    for i in range(150):
+        t = i / 30
+        estimate = TargetEstimate((x - 10.0, 170.0, 20.0, 20.0), (0.0, 0.0), 0.9, TrackState.TRACKING, t, i)
+        command = controller.update(estimate, (0.0, 0.0), t)
+        proportional = cfg.kp * (command.yaw_error_deg - cfg.deadband_deg)
+        assert command.yaw_dps <= proportional + cfg.integral_limit_dps + 1e-6
+    assert command.yaw_dps > proportional + 0.99 * cfg.integral_limit_dps  # it did reach the limit
+
+
+# A NaN control setting, a camera size that is no whole number of pixels, a NaN or infinite
+# focal length, and a controller clock that is not finite or runs backwards are refused by name
+# (they were accepted and later a 'cannot clamp NaN' or a silent zero output, e.g. feedforward=NaN).
+ESTIMATE = TargetEstimate(box=(400.0, 200.0, 40.0, 40.0), velocity=(0.0, 0.0), confidence=0.9,
+                          state=TrackState.TRACKING, timestamp=0.0, frame_index=1)
+
+
+@pytest.mark.parametrize("name", [f.name for f in dataclasses.fields(ControlConfig)])
+def test_a_nan_setting_is_refused_by_name(name: str) -> None:
+    with pytest.raises(ValueError, match=f"ControlConfig.{name} must be a number, not nan"):
+        ControlConfig(**{name: math.nan})
+
+
+@pytest.mark.parametrize("size", [(math.nan, 360), (640.5, 360), (None, 360), (640, True)])
+def test_a_camera_size_must_be_whole_pixels(size) -> None:
+    with pytest.raises(ValueError, match="whole pixels"):
+        CameraModel(*size)
+
+
+@pytest.mark.parametrize("focal", [math.nan, math.inf])
+def test_a_focal_length_must_be_finite(focal: float) -> None:
+    with pytest.raises(ValueError, match="focal_px must be positive and finite"):
+        CameraModel(640, 360, focal_px=focal)
+
+
+@pytest.mark.parametrize("name", ["pid", "p"])
+@pytest.mark.parametrize("times", [(math.nan,), (1.0, math.inf), (1.0, 0.5)])
+def test_the_clock_must_be_finite_and_not_run_backwards(name: str, times: tuple[float, ...]) -> None:
+    controller = make_controller(name, camera=CAM)
+    *before, bad = times
+    for now in before:
+        controller.update(ESTIMATE, (0.0, 0.0), now)
+    with pytest.raises(ValueError, match=f"now={bad!r} must be a finite time"):
+        controller.update(ESTIMATE, (0.0, 0.0), bad)
+
+
+# ``limit_rate`` on a missing setpoint and on limits beyond the protocol's speed range.
+def test_a_nan_setpoint_counts_as_exactly_zero() -> None:
+    assert limit_rate(0.5, math.nan, 100.0, 100.0, 0.1) == 0.0
+    assert limit_rate(-3.0, math.nan, 100.0, 100.0, 0.1) == 0.0
+    assert limit_rate(0.0, math.nan, 100.0, 100.0, 0.1) == 0.0
+
+
+@pytest.mark.parametrize("wanted", [1000.0, -1000.0])
+def test_the_protocol_range_caps_a_larger_speed_limit(wanted: float) -> None:
+    """The DJI R SDK speed command stops at 360 deg/s whatever limit a caller passes."""
+    assert PROTOCOL_MAX_SPEED_DPS == 360.0
+    assert limit_rate(0.0, wanted, 500.0, math.inf, 1.0) == math.copysign(360.0, wanted)
+
+
+def test_the_speed_range_holds_even_when_the_previous_setpoint_was_outside_it() -> None:
+    """A setpoint is never outside +-max_speed, even when that takes a step beyond ``max_accel * dt``
+    (a previous setpoint sent under a higher limit)."""
+    assert limit_rate(200.0, 200.0, 120.0, 600.0, 0.02) == 120.0
+    assert limit_rate(-400.0, -50.0, 500.0, 600.0, 0.02) == -360.0
+
+
+# A target found again after the controller stopped is filtered and controlled afresh.
+
+
+def _seen(x: float, t: float, index: int) -> TargetEstimate:
+    return TargetEstimate((x - 10.0, 170.0, 20.0, 20.0), (0.0, 0.0), 0.9, TrackState.TRACKING, t, index)
+
+
+def test_a_still_centred_target_found_after_a_loss_is_not_chased_with_the_old_motion() -> None:
+    """A subject panning at ~45 deg/s is lost for 1 s (over ``stop_within_s``), then found standing
+    still at the centre: no speed of the old pan (filter velocity, integral) may reach the gimbal."""
+    controller = RateController(CAM)
+    assert ControlConfig().stop_within_s < 1.0
+    for i in range(30):
+        controller.update(_seen(320.0 + 8.0 * i, i / 30, i), (0.0, 0.0), i / 30)
+    for i in range(30, 60):
+        assert controller.update(None, None, i / 30).mode in {"hold", "ramp", "idle"}
+    for i in range(60, 75):
+        command = controller.update(_seen(320.0, i / 30, i), (0.0, 0.0), i / 30)
+        assert command.mode == "track"
+        assert abs(command.yaw_dps) < 0.05 and abs(command.pitch_dps) < 0.05
+
+
+# Yaw errors and commands when the gimbal and an off-centre target straddle +-180 deg.
+
+
+def test_an_off_centre_target_across_the_wrap_keeps_a_small_error_and_the_same_direction() -> None:
+    """The gimbal pans through 180 deg with the target 20 px right of the centre (~2.2 deg): for the
+    frames where one is past the wrap and the other not, the error is not ~360 deg and the gimbal
+    is not sent the other way."""
+    controller = RateController(CAM)
+    for i in range(90):
+        t = i / 30
+        attitude = (wrap_deg(170.0 + 10.0 * t), 0.0)
+        estimate = TargetEstimate((330.0, 170.0, 20.0, 20.0), (0.0, 0.0), 0.9, TrackState.TRACKING, t, i)
+        command = controller.update(estimate, attitude, t)
+        assert abs(command.yaw_error_deg) < 5.0
+        assert command.yaw_dps >= 0.0
+
+
+def test_the_filtered_yaw_is_wrapped() -> None:
+    """The filter keeps yaw unwrapped inside; what it hands out is in [-180, 180)."""
+    kf = DirectionFilter()
+    for i in range(90):
+        t = i / 30
+        d = kf.update((wrap_deg(170.0 + 30.0 * t), 0.0), t)
+        assert -180.0 <= d.yaw < 180.0
+    assert d.yaw == pytest.approx(wrap_deg(170.0 + 30.0 * 89 / 30), abs=0.5)
+
+
+def test_extrapolation_wraps_the_yaw() -> None:
+    assert Direction(175.0, 2.0, 20.0, -1.0, 1.0).at(1.5) == pytest.approx((-175.0, 1.5))
+    assert Direction(-175.0, 0.0, -20.0, 0.0, 0.0).at(0.5) == pytest.approx((175.0, 0.0))

@@ -4,6 +4,7 @@ import pytest
 
 from pipelines.control.pid import Pid
 
+
 DT = 0.02
 
 
@@ -101,3 +102,23 @@ def test_a_call_that_does_not_integrate_leaves_the_integral_alone():
     pid(1.0, 0.5)
     assert pid(3.0, 0.5, integrate=False) == pytest.approx(3.0 + 1.0)
     assert pid.integral == pytest.approx(1.0)
+
+
+# The output of a step in which conditional integration holds the integral back.
+def test_the_output_is_recomputed_from_the_held_integral() -> None:
+    """kp * 1.9 = 1.9 plus the step's integral 0.19 would pass the 2.0 limit: the integral is held
+    at 0, and the output is what that gives (1.9), not the limit reached with the discarded growth."""
+    pid = Pid(kp=1.0, ki=5.0, output_limit=2.0)
+    assert pid(1.9, 0.02) == pytest.approx(1.9)
+    assert pid.integral == 0.0
+
+
+# Conditional integration when a later limiter holds the output above what the PID wants.
+def test_no_windup_while_held_at_a_positive_lower_bound() -> None:
+    """Slowing from a high speed, the acceleration limit keeps the command within (5, 8): the PID
+    wants a little less than zero (error -1), and its integral must not grow negative meanwhile."""
+    pid = Pid(kp=1.0, ki=2.0, output_limit=100.0)
+    for _ in range(50):
+        out = pid(-1.0, 0.02, bounds=(5.0, 8.0))
+    assert out == 5.0 and pid.integral == 0.0
+    assert pid(1.0, 0.02) == pytest.approx(1.0 + 2.0 * 0.02)  # nothing wound up to unwind

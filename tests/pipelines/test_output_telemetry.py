@@ -70,3 +70,15 @@ def test_estimate_fields() -> None:
     estimate = TargetEstimate((10.0, 20.0, 30.0, 40.0), (1.5, -2.0), 0.75, TrackState.TRACKING, 1.25, 37)
     assert estimate_fields(estimate) == {"box": [10.0, 20.0, 30.0, 40.0],
                                          "velocity": [1.5, -2.0], "confidence": 0.75, "state": "tracking"}
+
+
+# A telemetry line that cannot be written (a full disk) raises an ``OSError`` naming the file, so
+# the one-line error of the run says which output failed.
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_failed_write_names_the_telemetry_file(tmp_path: Path) -> None:
+    path = tmp_path / "telemetry.jsonl"
+    path.symlink_to("/dev/full")
+    writer = TelemetryWriter(path)
+    with pytest.raises(OSError, match=f"^cannot write the telemetry {path}: No space left on device$"):
+        writer.write({"frame": 0, "t": 0.0})
+    assert writer.records == 0

@@ -8,9 +8,11 @@ import cv2
 import numpy as np
 import pytest
 
-from pipelines.outputs.annotated_video import (STATE_COLOURS, AnnotatedVideoWriter,
-                                               BackgroundVideoWriter, annotate, video_size)
+from pipelines.outputs.annotated_video import (
+    AnnotatedVideoWriter, BackgroundVideoWriter, STATE_COLOURS, annotate, video_size,
+)
 from pipelines.sources import open_source
+from tests.support import wait_until
 from tracker.estimate import TargetEstimate, TrackState
 
 
@@ -132,3 +134,23 @@ def test_shrunk_video_keeps_the_annotation_on_the_subject(tmp_path: Path) -> Non
     assert edge[2] > 120 and edge[0] < 80 and edge[1] < 80
     with pytest.raises(ValueError, match="max_width must be at least 2"):
         AnnotatedVideoWriter(tmp_path / "bad.avi", (320, 240), 30.0, max_width=1)
+
+
+# BackgroundVideoWriter: a failure in its worker reaches the next ``write`` (so a run ends when its
+# video cannot be written, not only at the end), once.
+def test_a_worker_failure_is_raised_by_a_later_write(tmp_path: Path) -> None:
+    writer = BackgroundVideoWriter(tmp_path / "bad.avi", (64, 48), 10.0)
+    writer.write(np.zeros((10, 10, 3), np.uint8))  # wrong size: fails in the worker thread
+    good = np.zeros((48, 64, 3), np.uint8)
+
+    def write_fails() -> bool:
+        try:
+            writer.write(good)
+        except ValueError as exc:
+            assert "frame is 10x10" in str(exc)
+            return True
+        return False
+
+    assert wait_until(write_fails, timeout=10.0)
+    writer.write(good)  # already reported: quiet, and the worker keeps draining
+    writer.close()

@@ -1,13 +1,15 @@
 """Video files and image folders: frames, metadata, timestamps, pacing and errors."""
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-from pipelines.sources import SourceError, open_source
+from pipelines.sources import FrameSource, SourceError, open_source
 from pipelines.sources.files import ASSUMED_FPS, Pacer
 
 
@@ -160,3 +162,53 @@ def test_a_benchmark_sequence_folder_is_read_from_its_frames_subfolder(tmp_path:
     (tmp_path / "groundtruth_rect.txt").write_text("1,2,3,4\n")
     with open_source(str(tmp_path)) as source:
         assert source.frame_count == 3 and len(list(source)) == 3
+
+
+# A file source read again after its end or after a decode error returns ``None`` at once, never
+# waits for a decoder thread that has already finished.
+def _read_again(source: FrameSource) -> list[object]:
+    """``source.read()`` on a helper thread: what it returned, or nothing if it is still waiting."""
+    result: list[object] = []
+    reader = threading.Thread(target=lambda: result.append(source.read()), daemon=True)
+    reader.start()
+    reader.join(5.0)
+    return result
+
+
+def test_a_read_after_the_end_is_none(small_video: Path) -> None:
+    with open_source(str(small_video)) as source:
+        assert len(list(source)) == 12
+        assert _read_again(source) == [None]
+
+
+def test_a_read_after_a_decode_error_is_none(tmp_path: Path, frame_image: Callable[..., object]) -> None:
+    for i, size in enumerate([(96, 64), (80, 64), (96, 64)]):
+        cv2.imwrite(str(tmp_path / f"{i:04d}.png"), frame_image(i, size))
+    with open_source(str(tmp_path)) as source:
+        assert source.read() is not None
+        with pytest.raises(SourceError, match="0001.png is 80x64"):
+            source.read()
+        assert _read_again(source) == [None]
+
+
+# ``open_source`` takes a path object and an int camera index as well as strings (both were an
+# AttributeError on ``.strip``), and names any other type in a SourceError.
+def test_a_path_object_opens_like_its_string(small_video: Path) -> None:
+    with open_source(small_video) as by_path, open_source(str(small_video)) as by_text:
+        assert [f.index for f in by_path] == [f.index for f in by_text]
+
+
+def test_a_missing_path_object_is_named(tmp_path: Path) -> None:
+    with pytest.raises(SourceError, match="no such video file or image folder"):
+        open_source(tmp_path / "missing.mp4")
+
+
+def test_an_int_index_is_a_camera() -> None:
+    with pytest.raises(SourceError, match="camera 97 does not open"):
+        open_source(97)
+
+
+@pytest.mark.parametrize("spec", [None, 1.5, True, b"clip.mp4"])
+def test_other_types_are_named(spec: object) -> None:
+    with pytest.raises(SourceError, match="a source is a path, camera index or stream URL, not"):
+        open_source(spec)  # type: ignore[arg-type]

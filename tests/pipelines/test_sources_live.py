@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from pipelines.sources import SourceError, open_source
-from pipelines.sources.live import LatestFrameGrabber, LiveSource, open_interruptibly
+from pipelines.sources.live import LatestFrameGrabber, LiveSource, _Opening, open_interruptibly
 from tests.support import free_udp_port, require_ffmpeg
+
 
 WAIT = 10.0  # generous bound for thread hand-offs; tests never assert on durations
 
@@ -225,3 +226,109 @@ def test_udp_stream_is_read_live_and_stalls_when_the_sender_stops(
     assert indexes == sorted(set(indexes))
     assert stamps == sorted(stamps) and stamps[0] < stamps[-1]
     assert all(f.image.shape == (120, 160, 3) for f in frames)
+
+
+# A live capture is released whichever way its source ends, even when the wait for its opening is
+# interrupted just as it opened (a camera must not stay held, busy for the next run, by a source that
+# failed to open); and a read that hands back no image is no frame.
+
+
+class ScriptedCapture:
+    """Hands out ``reads`` in order, then fails every read; records its release."""
+
+    def __init__(self, reads: list[tuple[bool, np.ndarray | None]]) -> None:
+        self._reads = list(reads)
+        self.released = threading.Event()
+
+    def read(self) -> tuple[bool, np.ndarray | None]:
+        return self._reads.pop(0) if self._reads else (False, None)
+
+    def release(self) -> None:
+        self.released.set()
+
+
+def test_a_live_source_that_never_delivers_releases_its_capture() -> None:
+    capture = ScriptedCapture([])
+    with pytest.raises(SourceError, match="no frame from silent camera within 0.1 s"):
+        LiveSource(capture, "silent camera", open_timeout=0.1)
+    assert capture.released.wait(WAIT)
+
+
+def test_a_read_that_reports_success_without_an_image_is_no_frame() -> None:
+    image = np.full((4, 6, 3), 7, np.uint8)
+    capture = ScriptedCapture([(True, None), (True, image)])
+    grabber = LatestFrameGrabber(capture)
+    grabber.start()
+    try:
+        frame = grabber.get(WAIT)
+        assert frame is not None and frame.image is image and frame.index == 0
+        assert grabber.grabbed == 1 and grabber.dropped == 0
+    finally:
+        grabber.stop()
+    assert capture.released.wait(WAIT)
+
+
+class _InterruptedAfterTheOpen(threading.Event):
+    """An event whose wait is cut short by a signal's exception just as the capture has opened."""
+
+    def wait(self, timeout: float | None = None) -> bool:
+        super().wait(timeout)
+        raise KeyboardInterrupt
+
+
+def test_a_capture_that_opened_as_the_wait_was_interrupted_is_released() -> None:
+    capture = ScriptedCapture([])
+    opening = _Opening(lambda: capture)
+    opening._done = _InterruptedAfterTheOpen()
+    opening.run()  # opened before anyone gave up on it
+    with pytest.raises(KeyboardInterrupt):
+        opening.wait()
+    assert capture.released.is_set()
+
+
+# A live source's first read: the frame that opened it is handed out only if nothing newer came
+# meanwhile; a newer one replaces it, and the opening frame counts as dropped.
+
+
+class GatedCapture:
+    """One frame, then ``later`` more once ``go`` is set; after those, reads block until ``done``
+    is set and then fail (a stream with nothing more to say)."""
+
+    def __init__(self, later: int) -> None:
+        self.go = threading.Event()
+        self.delivered = threading.Event()
+        self.done = threading.Event()
+        self._later = later
+        self._served = 0
+
+    def read(self) -> tuple[bool, np.ndarray | None]:
+        if self._served > self._later:
+            self.delivered.set()
+            self.done.wait(WAIT)
+            return False, None
+        if self._served == 1:
+            self.go.wait(WAIT)
+        self._served += 1
+        return True, np.full((4, 6, 3), self._served - 1, np.uint8)
+
+    def release(self) -> None:
+        pass
+
+
+def test_a_newer_frame_replaces_the_one_the_source_opened_with() -> None:
+    capture = GatedCapture(later=2)
+    with LiveSource(capture, "gated", stall_timeout=WAIT, open_timeout=WAIT) as source:
+        capture.go.set()
+        assert capture.delivered.wait(WAIT)
+        frame = source.read()
+        assert frame is not None and frame.index == 2 and int(frame.image[0, 0, 0]) == 2
+        assert source.dropped == 2  # frame 1 in the grabber, frame 0 at this read
+        capture.done.set()
+
+
+def test_the_opening_frame_is_handed_out_when_nothing_newer_came() -> None:
+    capture = GatedCapture(later=0)
+    with LiveSource(capture, "gated", stall_timeout=WAIT, open_timeout=WAIT) as source:
+        frame = source.read()
+        assert frame is not None and frame.index == 0 and source.dropped == 0
+        capture.done.set()

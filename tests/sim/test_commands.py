@@ -6,11 +6,16 @@ import time
 import pytest
 
 from gimbal.errors import ReturnCodeError
-from gimbal.messages import Kind, all_message_classes, camera, decode_message, motion, tlv_params
-from gimbal.messages.tlv_params import describe_user_param, motors_off, param_table, roll360_mode
-from gimbal.packet import NO_REPLY, REPLY_OPTIONAL, Packet
+from gimbal.messages import Kind, all_message_classes, camera, decode_message, motion, settings, tlv_params
+from gimbal.messages.tlv_params import (
+    AutoCalibration, CALIBRATION_DONE, CALIBRATION_RUNNING, autotune, describe_user_param, motors_off,
+    param_table, roll360_mode,
+)
+from gimbal.packet import NO_REPLY, Packet, REPLY_OPTIONAL
 from gimbal.sim import SimConfig
+from gimbal.sim.model import GimbalModel
 from tests.sim.helpers import wait_until
+
 
 COMMANDS = [c for c in all_message_classes() if c.KIND is Kind.COMMAND]
 HOST_PUSHES = [c for c in all_message_classes() if c.KIND is Kind.PUSH and c.SENDER.value == "host"]
@@ -214,3 +219,68 @@ def test_state_is_telemetry(make_client) -> None:
     record = json.loads(json.dumps(sim.state().as_dict()))
     assert record["recording"] is True and record["commands"]["camera_action"] == 1
     assert record["sent"]["camera_action_reply"] == 1
+
+
+# Auto-calibration (0x0F) started while it runs fails with 0x02 and does not restart it.
+def test_a_second_start_while_running_fails_and_keeps_the_first_schedule() -> None:
+    """Started at 0 s (3 s run), started again at 1 s: 0x02, still done at 3 s, not 4 s."""
+    model = GimbalModel(SimConfig(calibration_s=3.0), 0.0)
+    assert model.handle(AutoCalibration((autotune(True),)), 0.0).ok
+    reply = model.handle(AutoCalibration((autotune(True),)), 1.0)
+    assert reply.return_code == 0x02
+    model.advance(2.0)
+    assert model.calibration[0] == CALIBRATION_RUNNING and model.calibration[1] >= 60
+    pushes = model.advance(3.05)
+    assert model.calibration == (CALIBRATION_DONE, 100)
+    assert any(isinstance(m, tlv_params.CalibrationStatusPush) for m in pushes)
+
+
+def test_start_after_done_is_accepted() -> None:
+    """Only a running calibration blocks a start: once done, a new one may begin."""
+    model = GimbalModel(SimConfig(calibration_s=1.0), 0.0)
+    assert model.handle(AutoCalibration((autotune(True),)), 0.0).ok
+    model.advance(1.5)
+    assert model.handle(AutoCalibration((autotune(True),)), 1.5).ok
+    model.advance(1.6)
+    assert model.calibration[0] == CALIBRATION_RUNNING
+
+
+# Work mode (0x0D) orientation changes are motion: refused with 0x02 while the motors are off.
+def test_portrait_with_motors_off_fails_and_keeps_the_orientation() -> None:
+    """Motors off: portrait (0x03) replies 0x02, orientation stays 0°; back on, it is accepted."""
+    model = GimbalModel(SimConfig(), 0.0)
+    assert model.handle(tlv_params.SetUserParams((motors_off(True),)), 0.0).ok
+    assert model.handle(settings.SetWorkMode(orientation=0x03), 0.0).return_code == 0x02
+    assert model.orientation == 0
+    assert model.handle(settings.SetWorkMode(orientation=0x00), 0.0).ok  # no orientation change: fine
+    assert model.handle(tlv_params.SetUserParams((motors_off(False),)), 0.1).ok
+    assert model.handle(settings.SetWorkMode(orientation=0x03), 0.1).ok
+    assert model.orientation == 90
+
+
+# A position move ends the selfie pose: the next selfie command turns yaw round again, not back to 0.
+def test_selfie_after_a_position_move_goes_to_the_selfie_yaw_again() -> None:
+    """Selfie (yaw 179°, the default limit), position to yaw 30°, selfie again: yaw 179°, selfie set."""
+    model = GimbalModel(SimConfig(), 0.0)
+    assert model.handle(settings.RecenterSelfie(action=settings.SELFIE), 0.0).ok
+    model.advance(2.0)  # 179° at 100 °/s
+    assert model.joint()[0] == 179.0 and model.selfie
+    assert model.handle(motion.PositionControl(yaw_angle=300, time_for_action=5), 2.0).ok
+    model.advance(4.0)
+    assert model.joint()[0] == 30.0 and not model.selfie
+    assert model.handle(settings.RecenterSelfie(action=settings.SELFIE), 4.0).ok
+    model.advance(6.0)
+    assert model.joint()[0] == 179.0 and model.selfie
+
+
+# Packets with the reply bit set that reach the simulator are ignored and counted, never executed.
+def test_a_reply_shaped_camera_action_is_not_executed(sim_host) -> None:  # type: ignore[no-untyped-def]
+    """A "start recording" payload sent with the reply bit: no reply, not recording, counted."""
+    host, sim = sim_host
+    payload = int(camera.CameraActionCode.START_RECORDING).to_bytes(2, "little")
+    host.transport.send(Packet.reply(0x0D, 0x00, payload, 7))
+    assert host.transport.recv(0.15) is None
+    time.sleep(0.02)
+    state = sim.state()
+    assert not state.recording and state.commands.get("camera_action", 0) == 0
+    assert state.faults["replies_received"] == 1

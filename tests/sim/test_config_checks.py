@@ -6,11 +6,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 import pytest
 
-from gimbal.sim import Faults, SimConfig
+from gimbal.sim import Faults, SimConfig, start_in_process
 from gimbal.sim.checks import FieldError
+
 
 NAN, INF = math.nan, math.inf
 
@@ -54,3 +54,17 @@ def test_numpy_numbers_are_taken_and_answered(make_client) -> None:
                             Faults(nack_code=np.uint8(3), delay_s=np.float64(0.0)))
     reply = client.version()
     assert (reply.device_id, reply.version_text) == (1, "01.02.03.04")
+
+
+# A stopped simulated gimbal says it cannot be started again (it said "already started").
+def test_start_after_stop_names_the_stop() -> None:
+    host_bus, sim = start_in_process()
+    try:
+        with pytest.raises(RuntimeError, match="already started"):
+            sim.start()
+        sim.stop()
+        with pytest.raises(RuntimeError, match="stopped simulated gimbal cannot be started again"):
+            sim.start()
+    finally:
+        sim.stop()
+        host_bus.shutdown()

@@ -8,6 +8,7 @@ import pytest
 
 from gimbal.errors import ReturnCodeError
 from gimbal.messages import external, motion, settings, telemetry
+from gimbal.messages.telemetry import PUSH_DISABLE, PUSH_ENABLE, PushControl
 from gimbal.sim import SimConfig
 from gimbal.sim.dynamics import Axis, AxisRange
 from gimbal.sim.model import GimbalModel
@@ -159,3 +160,75 @@ def test_the_tick_thread_sleeps_until_something_is_due(make_client) -> None:
     client.set_push(True)
     time.sleep(0.5)
     assert 20 <= len(calls) <= 32, len(calls)  # 25 pushes at 50 Hz, plus the wake for the command
+
+
+# Re-enabling the parameter push (0x07) restarts its schedule: one push at once, then one a period.
+def push_times(model: GimbalModel, start: float, end: float, step: float = 0.001) -> list[float]:
+    """Times (to ``step``) at which ``advance`` returned a parameter push."""
+    times, now = [], start
+    while now <= end + 1e-9:
+        if any(isinstance(m, telemetry.ParameterPush) for m in model.advance(now)):
+            times.append(round(now, 3))
+        now += step
+    return times
+
+
+def test_a_push_re_enabled_long_after_it_was_disabled_keeps_the_configured_period() -> None:
+    """No catch-up burst: after 4 s off, the pushes are again 20 ms apart (50 Hz), the first at once."""
+    model = GimbalModel(SimConfig(push_rate_hz=50.0), 0.0)
+    assert model.handle(PushControl(PUSH_ENABLE), 0.0).ok
+    push_times(model, 0.0, 1.0)
+    assert model.handle(PushControl(PUSH_DISABLE), 1.0).ok
+    assert push_times(model, 1.0, 5.0, step=0.01) == []
+    assert model.handle(PushControl(PUSH_ENABLE), 5.0).ok
+    times = push_times(model, 5.0, 5.1)
+    assert times[0] == 5.0
+    gaps = [round(b - a, 3) for a, b in zip(times, times[1:])]
+    assert gaps and all(abs(g - 0.02) <= 0.0015 for g in gaps), gaps
+
+
+def test_a_late_advance_sends_one_catch_up_push_not_a_burst() -> None:
+    """The tick thread woken 200 ms late at 50 Hz: at most one extra push, then 20 ms apart again."""
+    model = GimbalModel(SimConfig(push_rate_hz=50.0), 0.0)
+    assert model.handle(PushControl(PUSH_ENABLE), 0.0).ok
+    assert push_times(model, 0.0, 0.0) == [0.0]
+    times = push_times(model, 0.2, 0.26)
+    assert times[0] == 0.2 and len(times) <= 5, times
+    assert all(b - a >= 0.019 for a, b in zip(times[2:], times[3:])), times
+
+
+# Commanded speeds never exceed ``max_speed_dps`` (speed control and joystick alike).
+def test_speed_control_above_the_maximum_is_held_to_it() -> None:
+    """200 °/s asked of a 100 °/s gimbal: it turns at 100 °/s (after the 720 °/s² ramp)."""
+    model = GimbalModel(SimConfig(max_speed_dps=100.0), 0.0)
+    assert model.handle(motion.SpeedControl(yaw_speed=2000, pitch_speed=-2000), 0.0).ok
+    state = model.snapshot(0.3, Counter(), Counter())
+    assert state.speeds[0] == pytest.approx(100.0) and state.speeds[2] == pytest.approx(-100.0)
+
+
+def test_a_full_scale_joystick_beyond_the_maximum_is_held_to_it() -> None:
+    """Joystick full scale 150 °/s on a 100 °/s gimbal: full deflection gives 100 °/s."""
+    model = GimbalModel(SimConfig(max_speed_dps=100.0), 0.0)
+    model.apply_push(external.JoystickPush(yaw_speed=external.JOYSTICK_RANGE[1]), 0.0)
+    assert model.snapshot(0.4, Counter(), Counter()).speeds[0] == pytest.approx(100.0)
+
+
+# Speed control toward the negative side stops at the lower (min) limits, as it does at the max.
+def test_negative_pitch_speed_stops_at_the_user_pitch_min() -> None:
+    """-100 °/s from -40° with pitch_min 45: held at -45°, at rest, not past the limit."""
+    model = GimbalModel(SimConfig(initial_joint_deg=(0.0, 0.0, -40.0)), 0.0)
+    limits = settings.SetAngleLimits(pitch_max=145, pitch_min=45, yaw_max=179, yaw_min=179,
+                                     roll_max=30, roll_min=30)
+    assert model.handle(limits, 0.0).ok
+    assert model.handle(motion.SpeedControl(pitch_speed=-1000), 0.0).ok
+    state = model.snapshot(0.3, Counter(), Counter())
+    assert state.joint[2] == -45.0 and state.speeds[2] == 0.0
+
+
+def test_negative_yaw_and_roll_speeds_stop_at_the_default_min_limits() -> None:
+    """Default limits: yaw −179°, roll −30°; a 0.5 s command that would overshoot stops there."""
+    model = GimbalModel(SimConfig(initial_joint_deg=(-170.0, -20.0, 0.0)), 0.0)
+    assert model.handle(motion.SpeedControl(yaw_speed=-1000, roll_speed=-1000), 0.0).ok
+    state = model.snapshot(0.4, Counter(), Counter())
+    assert state.joint[:2] == (-179.0, -30.0)
+    assert state.speeds[:2] == (0.0, 0.0)

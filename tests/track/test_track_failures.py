@@ -9,29 +9,28 @@ import signal
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
+import cv2
 import pytest
 
 import gimbal.sim
-from gimbal.client import GimbalClient
-from gimbal.errors import ReturnCodeError
 import pipelines.cli.bus
 import pipelines.cli.track_cmd
 import pipelines.outputs.plot
+import pipelines.track_session
+from gimbal.client import GimbalClient
+from gimbal.errors import ReturnCodeError
 from gimbal.sim import Faults
-from pipelines.outputs.telemetry import read_telemetry
+from pipelines.acquire import AcquiringSubject
+from pipelines.outputs.telemetry import TelemetryWriter, read_telemetry
 from tests import fake_onnx
 from tests.support import ROOT, cli_command, free_udp_port, subprocess_env, wait_until
 from tests.track.helpers import (
-    DEMO,
-    DEMO_ROI,
-    assert_stopped_at_end,
-    decoded,
-    run_track,
-    speed_commands,
-    start,
-    track_command,
+    DEMO, DEMO_ROI, assert_stopped_at_end, decoded, drifting, make_clip, roi_at, run_track, speed_commands,
+    start, track_command,
 )
+
 
 GROUP = "239.74.163.9"
 
@@ -311,3 +310,141 @@ def test_the_failure_that_ended_the_run_stays_in_the_summary(tmp_path: Path, cap
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "output failed" and "cannot write the CAN log" in summary["error"]
     assert "plot" not in summary["outputs"]
+
+
+# ``gimbaltrack track`` when the source fails or the code crashes part-way through a run: the
+# session itself stops the gimbal (zero, then release) and the summary says how the run ended,
+# with every frame so far in the telemetry.
+FRAMES = 20
+
+
+def _assert_stopped_by_the_session(out: Path, status: str, frames: int) -> dict[str, Any]:
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == status and summary["frames"] == frames
+    assert len(read_telemetry(out / "telemetry.jsonl")) == frames
+    sends = summary["speed_commands"]
+    assert sends["stop_zero_sent"] == sends["stop_release_sent"] == 1
+    assert_stopped_at_end(decoded(out / "can.log"))
+    return summary
+
+
+def test_a_source_failing_mid_run_stops_the_gimbal_and_exits_1(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    video = cv2.VideoCapture(str(make_clip(tmp_path / "clip.avi", FRAMES, drifting)))
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for i in range(FRAMES):
+        ok, image = video.read()
+        assert ok
+        if i == 12:  # one image of another size: the folder source fails there
+            image = cv2.resize(image, (160, 120))
+        cv2.imwrite(str(folder / f"{i:03d}.png"), image)
+    out = tmp_path / "out"
+    assert run_track(folder, out, "--roi", roi_at(drifting), "--no-video") == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("gimbaltrack track: error:")
+    assert "012.png" in err and "outputs so far are in" in err
+    summary = _assert_stopped_by_the_session(out, "source failed", 12)
+    assert "one frame size" in summary["error"]
+
+
+def test_a_crash_mid_run_stops_the_gimbal_and_keeps_the_outputs(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    real = AcquiringSubject.estimate
+    calls: list[int] = []
+
+    def crash_on_the_eighth(self: AcquiringSubject, *args: Any) -> Any:
+        calls.append(1)
+        if len(calls) == 8:
+            raise RuntimeError("a bug")
+        return real(self, *args)
+
+    monkeypatch.setattr(AcquiringSubject, "estimate", crash_on_the_eighth)
+    clip = make_clip(tmp_path / "clip.avi", FRAMES, drifting)
+    out = tmp_path / "out"
+    with pytest.raises(RuntimeError, match="a bug"):  # a bug shows its traceback
+        run_track(clip, out, "--roi", roi_at(drifting))
+    summary = _assert_stopped_by_the_session(out, "failed", 7)
+    assert summary["error"] == "RuntimeError('a bug')"
+    assert (out / "plot.png").exists()
+
+
+def test_a_telemetry_line_that_cannot_be_written_is_not_counted(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The disk fills up at the eighth frame's telemetry line: the summary's ``frames`` (and its
+    states) count the seven frames the telemetry holds, not the eighth, whose line is missing."""
+    real = TelemetryWriter.write
+    calls: list[int] = []
+
+    def full_at_the_eighth(self: TelemetryWriter, record: Any) -> None:
+        calls.append(1)
+        if len(calls) == 8:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(self, record)
+
+    monkeypatch.setattr(TelemetryWriter, "write", full_at_the_eighth)
+    out = tmp_path / "out"
+    assert run_track(make_clip(tmp_path / "clip.avi", FRAMES, drifting), out,
+                     "--roi", roi_at(drifting), "--no-video") == 1
+    summary = _assert_stopped_by_the_session(out, "output failed", 7)
+    assert sum(summary["states"].values()) == 7 and summary["angular_error_deg"]["frames"] <= 7
+
+
+# An output that cannot even be opened (here the telemetry's name taken by a folder) is a one-line
+# error and exit 2 before the gimbal is ever moved, not a traceback.
+def test_an_output_that_cannot_be_opened_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    def position(i: int) -> tuple[int, int]:
+        return 140 + i, 100
+
+    clip = make_clip(tmp_path / "clip.avi", 5, position)
+    out = tmp_path / "out"
+    (out / "telemetry.jsonl").mkdir(parents=True)
+    assert run_track(clip, out, "--roi", roi_at(position), "--no-video") == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("gimbaltrack track: error:")
+    assert "telemetry.jsonl" in err and "Traceback" not in err
+    assert speed_commands(decoded(out / "can.log")) == []
+
+
+# The last rewrite of ``summary.json`` failing (a full disk) after a run that went well: a one-line
+# error and exit 1, the gimbal stopped first, and the previous rewrite left in place.
+def test_a_final_summary_that_cannot_be_written_is_one_line_and_exit_1(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    real = pipelines.track_session.write_summary
+
+    def full_at_the_end(path: Path, summary: dict[str, Any], sync: bool = True) -> None:
+        if sync:  # the final rewrite; those during the run pass sync=False
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(path, summary, sync)
+
+    monkeypatch.setattr(pipelines.track_session, "write_summary", full_at_the_end)
+
+    clip = make_clip(tmp_path / "clip.avi", 12, drifting)
+    out = tmp_path / "out"
+    assert run_track(clip, out, "--roi", roi_at(drifting), "--no-video") == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("gimbaltrack track: error:")
+    assert "summary: No space left on device" in err and "the gimbal was told to stop" in err
+    assert json.loads((out / "summary.json").read_text())["status"] == "running"  # the last rewrite that fitted
+    assert_stopped_at_end(decoded(out / "can.log"))
+
+
+# A ``face_detection_yunet*.onnx`` in ``--model-dir`` that is damaged, or another network under
+# YuNet's name, is a one-line error naming the file, exit 2, before ``--out`` is created (it was a
+# cv2.error traceback: at the start for a damaged file, at the first frame, mid-run, for another
+# network).
+@pytest.mark.parametrize("content", [b"not a network", fake_onnx.head_bytes(), fake_onnx.backbone_bytes()],
+                         ids=["damaged", "nanotrack-head", "nanotrack-backbone"])
+def test_a_bad_yunet_file_is_a_one_line_error(content: bytes, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    models = tmp_path / "models"
+    models.mkdir()
+    model = models / "face_detection_yunet_2023mar.onnx"
+    model.write_bytes(content)
+    out = tmp_path / "out"
+    assert run_track(make_clip(tmp_path / "clip.avi", 5, drifting), out, "--detect", "face",
+                     "--model-dir", str(models), "--no-video") == 2
+    err = capsys.readouterr().err
+    assert err == (f"gimbaltrack track: error: YuNet face detector {model}: not a YuNet network "
+                   "(damaged or another file?)\n")
+    assert not out.exists()
