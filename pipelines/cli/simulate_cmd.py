@@ -8,6 +8,7 @@ import math
 import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,9 @@ from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
 from pipelines.progress import ProgressReporter
 from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers
+
+if TYPE_CHECKING:
+    from pipelines.loop import FrameRecord
 
 
 MAX_LATENCY_MS = 2000.0  # far beyond any pipeline worth simulating; a typo must not sleep for hours
@@ -120,7 +124,7 @@ class Outputs:
         from pipelines.outputs.can_log import CanLogWriter
         samples = loop.samples
 
-        def centre_error(record) -> float:  # noqa: ANN001 (a FrameRecord)
+        def centre_error(record: FrameRecord) -> float:
             sample = samples.get(record.index)
             return math.nan if sample is None else sample.error
 
@@ -157,7 +161,7 @@ def run(args: argparse.Namespace) -> int:
         if args.out:
             make_out_dir(args.out)
             outputs = Outputs(args.out, loop)  # shares the loop's samples, as the copy below does
-        frames = _CountedFrames(loop.frames, ProgressReporter(len(loop.seq),
+        frames = _CountedFrames(loop.frames, ProgressReporter(min(len(loop.seq), args.max_frames or len(loop.seq)),
                                                               enabled=not args.quiet and sys.stderr.isatty()))
         status = "stopped"
         try:
