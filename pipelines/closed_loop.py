@@ -16,8 +16,8 @@ from collections import deque
 from collections.abc import Iterator, Sequence as Seq
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import can
 import numpy as np
 
 from gimbal.client import GimbalClient
@@ -36,6 +36,9 @@ from tracker.detectors import Detection
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.evaluation import first_box
 from tracker.metrics import has_truth
+
+if TYPE_CHECKING:
+    import can
 
 ORACLE = "oracle"
 SIM_CONFIG = SimConfig(yaw_continuous=True)  # the simulated gimbal the loop turns
