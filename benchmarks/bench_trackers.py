@@ -1,8 +1,10 @@
 """Benchmark the project's trackers against OpenCV's own on every shared sequence, in one run.
 
 Prints per-sequence success AUC, mean AUC, mean precision@20px, median fps of the tracking
-step (one thread; wall clock, and process CPU time, which the machine's other load affects less)
-and ratios against OpenCV's CSRT measured alongside. Usage:
+step (one thread; wall clock, and process CPU time, which the machine's other load affects less),
+median fps on the 1280x720 sequences, and ratios against OpenCV's CSRT measured alongside. With
+model files, each model also runs as a plain reference loop (the backend alone: no confidence, no
+re-acquisition), and each subject tracker is compared with its model's plain loop. Usage:
 
     .venv/bin/python benchmarks/bench_trackers.py [--model-dir DIR] [--only LABEL]... [--starts] [SEQ ...]
 """
@@ -22,9 +24,12 @@ from tracker.data_paths import shared_data_dir, shared_sequences
 from tracker.datasets import Sequence, load_sequence
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
-from tracker.registry import make_tracker
+from tracker.registry import DEFAULT_MODEL_TRACKER, make_tracker
 
 BASELINE = "opencv-csrt"
+ONNX_MODELS = ("nanotrack3", "vittrack", "fear")  # each runs plain and inside the subject tracker
+PLAIN = "{} plain loop"
+HD = (1280, 720)  # the frame size the fps target is set for
 
 
 class BareBackend:
@@ -50,10 +55,14 @@ def contenders(model_dir: Path | None) -> dict[str, object]:
     table["gimbaltrack csrt-fast"] = lambda: make_tracker("csrt-fast")
     table["dcf backend alone"] = lambda: BareBackend(make_backend("dcf"))
     table["gimbaltrack default (no models: dcf)"] = lambda: make_tracker("default")
+    table[f"gimbaltrack default (embedded: {DEFAULT_MODEL_TRACKER})"] = lambda: make_tracker("default")
     if model_dir is not None:
         table["opencv-nano"] = lambda: BareBackend(make_backend("nano", model_dir))
         table["nanotrack backend alone"] = lambda: BareBackend(make_backend("nanotrack", model_dir))
-        table["gimbaltrack default (models: nanotrack)"] = lambda: make_tracker("default", model_dir)
+        table["gimbaltrack nanotrack"] = lambda: make_tracker("nanotrack", model_dir)
+        for name in ONNX_MODELS:
+            table[PLAIN.format(name)] = lambda name=name: BareBackend(make_backend(name, model_dir))
+            table[f"gimbaltrack {name}"] = lambda name=name: make_tracker(name, model_dir)
     return table
 
 
@@ -62,7 +71,9 @@ def main(argv: list[str] | None = None) -> int:
     default_models = shared_data_dir() / "models"
     parser.add_argument("--model-dir", type=Path, default=default_models if default_models.is_dir() else None)
     parser.add_argument("--only", action="append", metavar="LABEL",
-                        help="a label to run, repeatable (the CSRT baseline always runs)")
+                        help="a label to run, repeatable (the baseline always runs)")
+    parser.add_argument("--baseline", default=BASELINE, metavar="LABEL",
+                        help=f"the label the ratios are taken against (default: {BASELINE})")
     parser.add_argument("--starts", action="store_true",
                         help="also track from OTB's perturbed first boxes and print each tracker's mean AUC "
                              "over all starts (steadier than one start)")
@@ -79,15 +90,35 @@ def main(argv: list[str] | None = None) -> int:
         print(f"no sequences under {shared_data_dir() / 'sequences'}", file=sys.stderr)
         return 2
     table = contenders(args.model_dir)
-    labels = [k for k in table if not args.only or k == BASELINE or k in args.only]
+    if args.baseline not in table:
+        print(f"bench_trackers: no tracker labelled {args.baseline!r} (labels: {', '.join(table)})", file=sys.stderr)
+        return 2
+    labels = [k for k in table if not args.only or k == args.baseline or k in args.only]
     results: dict[str, list[SequenceResult]] = {}
     for label in labels:
         print(f"running {label} ...", file=sys.stderr, flush=True)
         results[label] = [run_sequence(table[label](), seq) for seq in sequences]
-    _print_table(results, [s.name for s in sequences])
+    hd = [i for i, seq in enumerate(sequences) if _frame_size(seq) == HD]
+    _print_table(results, [s.name for s in sequences], hd, args.baseline)
+    _print_against_plain_loops(results)
     if args.starts:
         _print_starts({label: table[label] for label in labels}, sequences, results)
     return 0
+
+
+def _frame_size(sequence: Sequence) -> tuple[int, int]:
+    first = next(iter(sequence.frames()))
+    return first.shape[1], first.shape[0]
+
+
+def _print_against_plain_loops(results: dict[str, list[SequenceResult]]) -> None:
+    """Each subject tracker's mean AUC and fps against its model's plain loop, run alongside."""
+    for name in ONNX_MODELS:
+        ours, plain = results.get(f"gimbaltrack {name}"), results.get(PLAIN.format(name))
+        if ours and plain:
+            a, b = summarize(ours), summarize(plain)
+            print(f"gimbaltrack {name} against its plain loop: AUC {a['auc']:.3f} vs {b['auc']:.3f} "
+                  f"({a['auc'] - b['auc']:+.3f}), fps {a['fps']:.0f} vs {b['fps']:.0f} ({a['fps'] / b['fps']:.2f}x)")
 
 
 def _print_starts(table: dict[str, object], sequences: list[Sequence],
@@ -103,20 +134,24 @@ def _print_starts(table: dict[str, object], sequences: list[Sequence],
             aucs = [first.auc] + [run_sequence(factory(), seq, start=perturbed_box(seq.groundtruth[0], *p)).auc
                                   for p in PERTURBED_STARTS]
             means.append(float(np.mean(aucs)))
-        print(f"| {label} | {' | '.join(f'{m:.2f}' for m in means)} | {np.mean(means):.3f} |")
+        print(f"| {label} | {' | '.join(f'{m:.2f}' for m in means)} | {np.mean(means):.3f} |", flush=True)
 
 
-def _print_table(results: dict[str, list[SequenceResult]], names: list[str]) -> None:
+def _print_table(results: dict[str, list[SequenceResult]], names: list[str], hd: list[int], baseline: str) -> None:
+    """One row per tracker: AUC per sequence, means, fps (all, and on the 1280x720 sequences ``hd``),
+    and ratios against ``baseline``."""
     print(describe_machine())
-    base = summarize(results[BASELINE])
+    base = summarize(results[baseline])
     short = [n.split("_", 1)[-1][:8] for n in names]
-    print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps "
-          "| AUC / CSRT | fps / CSRT | median CPU fps | CPU fps / CSRT |")
-    print("|---" * (len(names) + 8) + "|")
+    print(f"ratios against: {baseline}")
+    print(f"| tracker | {' | '.join(short)} | mean AUC | mean prec20 | median fps | median fps 1280x720 "
+          "| AUC ratio | fps ratio | median CPU fps | CPU fps ratio |")
+    print("|---" * (len(names) + 9) + "|")
     for label, rows in results.items():
         s = summarize(rows)
         cells = " | ".join(f"{r.auc:.2f}" for r in rows)
-        print(f"| {label} | {cells} | {s['auc']:.3f} | {s['prec20']:.3f} | {s['fps']:.0f} "
+        hd_fps = float(np.median([rows[i].fps for i in hd])) if hd else float("nan")
+        print(f"| {label} | {cells} | {s['auc']:.3f} | {s['prec20']:.3f} | {s['fps']:.0f} | {hd_fps:.0f} "
               f"| {s['auc'] / base['auc']:.2f} | {s['fps'] / base['fps']:.2f} | {s['cpu_fps']:.0f} "
               f"| {s['cpu_fps'] / base['cpu_fps']:.2f} |")
 

@@ -18,6 +18,7 @@ from gimbal.signals import deferred_signals
 from pipelines.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartConfirmer
 from pipelines.control import CameraModel, ControlConfig, make_controller
 from pipelines.control.gimbal_link import GimbalLink, Signs
+from pipelines.control.tuning import settings_of
 from pipelines.loop import (
     Loop, PlotSink, ProgressSink, Recorder, SummarySink, TelemetrySink, VideoSink, loop_panels,
 )
@@ -253,5 +254,6 @@ class TrackSession:
                            for k, v in latency_percentiles(self.link.latencies()).items()},
             "speed_commands": dict(self.link.stats()),
             "recording": self.recorder.status,
+            "settings": settings_of(self.loop.controller.config),
             "outputs": {k: str(v) for k, v in self.paths.items()},
         }

@@ -1,4 +1,5 @@
-"""Tracking backends: one small interface over our correlation filter and NanoTrack, and OpenCV's trackers."""
+"""Tracking backends: one small interface over our correlation filter, the model-based trackers
+(NanoTrack v2 and v3, VitTrack, FEAR-XS) and OpenCV's trackers."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -11,7 +12,11 @@ import numpy as np
 from tracker.boxes import Box, cut_to_frame
 from tracker.dcf import DcfBackend
 from tracker.frames import as_bgr, as_bgr_or_grey
-from tracker.nanotrack import NanoTrackBackend, load_nanotrack_networks, nanotrack_model_files
+from tracker.fear import FearBackend
+from tracker.nanotrack import (V3_PARAMS, NanoTrackBackend, OrtNanoNetworks, load_nanotrack_networks,
+                               nanotrack_model_files)
+from tracker.onnx_sessions import DEFAULT_THREADS
+from tracker.vittrack import VitTrackBackend
 
 
 class TrackingBackend(Protocol):
@@ -120,23 +125,32 @@ def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
 _NANO_PROBE_BOX = 32  # side of the box the model-file check starts TrackerNano on, pixels
 
 
-BACKEND_NAMES = ("dcf", "nanotrack", "csrt-fast", "csrt", "kcf", "mil", "mosse", "nano")
+BACKEND_NAMES = ("dcf", "nanotrack", "nanotrack3", "vittrack", "fear", "csrt-fast", "csrt", "kcf", "mil", "mosse",
+                 "nano")
+# Backends that need model files (``model_dir``); the last three run on onnxruntime.
+MODEL_BACKENDS = ("nanotrack", "nano", "nanotrack3", "vittrack", "fear")
 # OpenCV's KCF and Nano fail on grey frames; the others take grey as it is (cheaper than three channels).
 NEEDS_BGR = ("kcf", "nano")
 
 
-def make_backend(name: str, model_dir: str | Path | None = None) -> TrackingBackend:
-    """A fresh backend by name (one of ``BACKEND_NAMES``) taking grey, BGR and BGRA frames;
-    ``nanotrack`` and ``nano`` need ``model_dir``."""
-    return ConvertingBackend(_bare_backend(name, model_dir), as_bgr if name in NEEDS_BGR else as_bgr_or_grey)
+def make_backend(name: str, model_dir: str | Path | None = None, threads: int = DEFAULT_THREADS) -> TrackingBackend:
+    """A fresh backend by name (one of ``BACKEND_NAMES``) taking grey, BGR and BGRA frames; those in
+    ``MODEL_BACKENDS`` need ``model_dir``; ``threads`` is onnxruntime's intra-op thread count."""
+    return ConvertingBackend(_bare_backend(name, model_dir, threads), as_bgr if name in NEEDS_BGR else as_bgr_or_grey)
 
 
-def _bare_backend(name: str, model_dir: str | Path | None) -> TrackingBackend:
+def _bare_backend(name: str, model_dir: str | Path | None, threads: int) -> TrackingBackend:
     """The backend by name, taking frames in whichever formats it takes itself."""
     if name == "dcf":
         return DcfBackend()
     if name == "nanotrack":
         return NanoTrackBackend(model_dir)
+    if name == "nanotrack3":
+        return NanoTrackBackend(model_dir, V3_PARAMS, OrtNanoNetworks(model_dir, threads), name)
+    if name == "vittrack":
+        return VitTrackBackend(model_dir, threads=threads)
+    if name == "fear":
+        return FearBackend(model_dir, threads=threads)
     if name == "csrt-fast":
         return OpenCvBackend(name, _csrt(**FAST_CSRT))
     if name == "csrt":

@@ -122,3 +122,4 @@ def summarize(results: list[SequenceResult]) -> dict[str, float | None]:
             "auc": round(float(np.mean([r.auc for r in results])), 4),
             "fps": _median_rate(r.fps for r in results),
             "cpu_fps": _median_rate(r.cpu_fps for r in results)}
+

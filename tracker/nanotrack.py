@@ -1,9 +1,9 @@
-"""NanoTrack v2 run with ``cv2.dnn``: Siamese search and anchor-free box decoding in numpy.
+"""NanoTrack v2 (on ``cv2.dnn``) and v3 (on onnxruntime): Siamese search and anchor-free box decoding.
 
 The two networks are NanoTrack's: a backbone (template 127 px -> 8x8 features, search 255 px ->
-16x16 features) and a neck/head correlating them into a 16x16 map of foreground scores and of
-box-side distances (left, top, right, bottom) from each map point, stride 16 px in the search
-crop. The post-processing is SiamBAN's: a penalty on changes of box size and aspect ratio, a
+16x16 features) and a neck/head correlating them into a map of foreground scores and of box-side
+distances (left, top, right, bottom) from each map point, stride 16 px in the search crop: 16x16
+for v2, 15x15 for v3 (which ``cv2.TrackerNano`` cannot run). The post-processing is SiamBAN's: a penalty on changes of box size and aspect ratio, a
 cosine window favouring small motion, and a size learning rate scaled by the peak's score.
 
 The foreground score stays near 1 on background, so the backend's score is that score times the
@@ -25,11 +25,14 @@ import numpy as np
 from tracker.boxes import Box, from_center
 from tracker.crops import resample_window
 from tracker.model_files import find_model_file
+from tracker.onnx_sessions import DEFAULT_THREADS, OnnxNetwork
 
 EXEMPLAR_SIZE = 127  # template crop side, pixels
 INSTANCE_SIZE = 255  # search crop side, pixels
 STRIDE = 16  # search-crop pixels per score-map cell
-SCORE_SIZE = 16  # score map side (the head only accepts a 16x16 search feature map)
+SCORE_SIZE = 16  # v2's score map side (its head only accepts a 16x16 search feature map)
+V3_SCORE_SIZE = 15  # v3's score map side
+SEARCH_FEATURES = 16  # the backbone's feature map side for a search crop
 TEMPLATE_FEATURES = 8  # the backbone's feature map side for a template crop
 TEMPLATE_MIDDLE = ((TEMPLATE_FEATURES - 1) / 2, (TEMPLATE_FEATURES - 1) / 2)  # its centre, in cells (col, row)
 MIN_SIZE = 10.0  # smallest box side kept, pixels
@@ -62,6 +65,12 @@ class NanoTrackParams:
     likeness_zero: float = 0.5
 
 
+#: The reference tracker's settings for v3 (SiamTrackers), without our motion prediction or size
+#: calibration, which were tuned on five clips for v2.
+V3_PARAMS = NanoTrackParams(window_influence=0.455, penalty_k=0.138, size_lr=0.348, velocity_gain=0.0,
+                            calibration_strength=0.0)
+
+
 def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
     """The backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v2/``)."""
     if model_dir is None:
@@ -81,7 +90,7 @@ def load_nanotrack_networks(model_dir: str | Path | None) -> tuple[cv2.dnn.Net, 
     backbone_path, head_path = nanotrack_model_files(model_dir)
     backbone = _read_network(backbone_path, "backbone")
     template = _backbone_features(backbone, backbone_path, EXEMPLAR_SIZE, TEMPLATE_FEATURES)
-    search = _backbone_features(backbone, backbone_path, INSTANCE_SIZE, SCORE_SIZE)
+    search = _backbone_features(backbone, backbone_path, INSTANCE_SIZE, SEARCH_FEATURES)
     head = _read_network(head_path, "neck/head")
     _check_head(head, head_path, template, search)
     return backbone, head
@@ -125,6 +134,73 @@ def _check_head(net: cv2.dnn.Net, path: Path, template: np.ndarray, search: np.n
     if shapes != ((1, 2, SCORE_SIZE, SCORE_SIZE), (1, 4, SCORE_SIZE, SCORE_SIZE)):
         raise ValueError(f"NanoTrack neck/head {path}: not NanoTrack's neck/head network (it must take the "
                          "backbone's template and search features; is it a second backbone?)")
+
+
+def nanotrack_v3_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
+    """NanoTrack v3's backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v3/``)."""
+    if model_dir is None:
+        raise FileNotFoundError("NanoTrack v3 needs its model files: pass a model directory holding "
+                                "nanotrack_v3/nanotrack_backbone*.onnx and nanotrack_head*.onnx")
+    backbone = find_model_file(model_dir, "nanotrack_v3", "nanotrack_backbone*.onnx", "NanoTrack v3")
+    head = find_model_file(model_dir, "nanotrack_v3", "nanotrack_head*.onnx", "NanoTrack v3")
+    return backbone, head
+
+
+class CvNanoNetworks:
+    """NanoTrack v2's two networks on ``cv2.dnn``: backbone features, then the head's maps."""
+
+    score_size = SCORE_SIZE
+
+    def __init__(self, model_dir: str | Path | None) -> None:
+        self._backbone, self._head = load_nanotrack_networks(model_dir)
+
+    def features(self, blob: np.ndarray) -> np.ndarray:
+        self._backbone.setInput(blob)
+        return self._backbone.forward()
+
+    def set_template(self, features: np.ndarray) -> None:
+        self._head.setInput(features, "input1")
+
+    def head(self, features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The (1, 2, S, S) background/foreground logits and (1, 4, S, S) box sides for search features."""
+        self._head.setInput(features, "input2")
+        cls, loc = self._head.forward(["output1", "output2"])
+        return cls, loc
+
+
+class OrtNanoNetworks:
+    """NanoTrack v3's two networks on onnxruntime, each checked on loading (``ValueError`` naming a
+    file that is not the network its name says). The backbone file declares 255 px crops, which
+    onnxruntime holds it to, so the 127 px template crop (once per start) goes through ``cv2.dnn``,
+    which runs the same file at any size (equal features to 1e-5 on a 255 px crop)."""
+
+    score_size = V3_SCORE_SIZE
+
+    def __init__(self, model_dir: str | Path | None, threads: int = DEFAULT_THREADS, channels: int = 96) -> None:
+        backbone, head = nanotrack_v3_model_files(model_dir)
+        self._backbone = OnnxNetwork(backbone, "NanoTrack v3 backbone", {"input": (1, 3, INSTANCE_SIZE, INSTANCE_SIZE)},
+                                     {"output": (1, channels, SEARCH_FEATURES, SEARCH_FEATURES)}, threads)
+        maps = (V3_SCORE_SIZE, V3_SCORE_SIZE)
+        self._head = OnnxNetwork(head, "NanoTrack v3 neck/head",
+                                 {"input1": (1, channels, TEMPLATE_FEATURES, TEMPLATE_FEATURES),
+                                  "input2": (1, channels, SEARCH_FEATURES, SEARCH_FEATURES)},
+                                 {"output1": (1, 2, *maps), "output2": (1, 4, *maps)}, threads)
+        self._template = np.zeros((1, channels, TEMPLATE_FEATURES, TEMPLATE_FEATURES), np.float32)
+        self._template_backbone = _read_network(backbone, "v3 backbone")
+        _backbone_features(self._template_backbone, backbone, EXEMPLAR_SIZE, TEMPLATE_FEATURES)
+
+    def features(self, blob: np.ndarray) -> np.ndarray:
+        if blob.shape[2] == INSTANCE_SIZE:
+            return self._backbone.run(input=blob)["output"]
+        self._template_backbone.setInput(blob)
+        return self._template_backbone.forward()
+
+    def set_template(self, features: np.ndarray) -> None:
+        self._template = features
+
+    def head(self, features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        out = self._head.run(input1=self._template, input2=features)
+        return out["output1"], out["output2"]
 
 
 def hanning_window(size: int) -> np.ndarray:
@@ -236,15 +312,17 @@ class Peak:
 
 
 class NanoTrackBackend:
-    """NanoTrack v2 (``TrackingBackend``): score = foreground probability of the chosen peak times
-    its deep-feature likeness to the subject relative to the likeness's running typical value."""
+    """NanoTrack v2 or v3 (``TrackingBackend``): score = foreground probability of the chosen peak
+    times its deep-feature likeness to the subject relative to the likeness's running typical value.
+    ``networks`` defaults to v2's on ``cv2.dnn`` (:class:`OrtNanoNetworks` runs v3)."""
 
-    def __init__(self, model_dir: str | Path | None, params: NanoTrackParams | None = None) -> None:
-        self.name = "nanotrack"
+    def __init__(self, model_dir: str | Path | None, params: NanoTrackParams | None = None,
+                 networks: CvNanoNetworks | OrtNanoNetworks | None = None, name: str = "nanotrack") -> None:
+        self.name = name
         self.params = params or NanoTrackParams()
-        self._backbone, self._head = load_nanotrack_networks(model_dir)
-        self._window = hanning_window(SCORE_SIZE)
-        self._offsets = grid_offsets()
+        self._networks = networks or CvNanoNetworks(model_dir)
+        self._window = hanning_window(self._networks.score_size)
+        self._offsets = grid_offsets(self._networks.score_size)
         self._center = np.zeros(2)
         self._size = np.ones(2)
         self._velocity = np.zeros(2)  # the centre's motion over the last frame, pixels
@@ -262,7 +340,7 @@ class NanoTrackBackend:
         self._fill = tuple(float(v) for v in cv2.mean(frame)[:3])
         side = self._context_side()
         template = self._template(frame, self._center, side)
-        self._head.setInput(template, "input1")
+        self._networks.set_template(template)
         cells = np.clip(np.round(self._size * EXEMPLAR_SIZE / side / STRIDE), 1, TEMPLATE_FEATURES).astype(int)
         self._subject_features = sample_cells(template[0], TEMPLATE_MIDDLE, (int(cells[0]), int(cells[1])))
         self._typical_likeness = 0.0
@@ -342,21 +420,19 @@ class NanoTrackBackend:
         if crop.ndim == 2:  # the networks take three channels
             crop = cv2.cvtColor(crop, cv2.COLOR_GRAY2BGR)
         blob = cv2.dnn.blobFromImage(crop, 1.0, swapRB=self.params.swap_rb)
-        self._backbone.setInput(blob)
-        return self._backbone.forward()
+        return self._networks.features(blob)
 
     def _search(self, frame: np.ndarray, center: np.ndarray, side: float) -> Peak:
         """The best peak in the search crop of ``side`` image pixels centred on ``center``."""
         crop = crop_square(frame, *center, side, INSTANCE_SIZE, self._fill)
         features = self._features(crop)
-        self._head.setInput(features, "input2")
-        cls, loc = self._head.forward(["output1", "output2"])
+        cls, loc = self._networks.head(features)
         score = foreground_score(cls[0])
         boxes = decode_boxes(loc[0], self._offsets)
         scale = INSTANCE_SIZE / side  # crop pixels per image pixel
         (row, col), penalty = select_peak(score, boxes, self._size * scale, self._window, self.params)
         bcx, bcy, bw, bh = boxes[:, row, col]
-        middle = (SCORE_SIZE - 1) / 2  # the search features' cell at the crop's centre
+        middle = (SEARCH_FEATURES - 1) / 2  # the search features' cell at the crop's centre
         cell = (middle + bcx / STRIDE, middle + bcy / STRIDE)
         box = (float(center[0] + bcx / scale), float(center[1] + bcy / scale), float(bw / scale), float(bh / scale))
         return Peak(box, float(score[row, col]), penalty, features[0], cell)

@@ -25,6 +25,7 @@ class TrackerSettings:
     """Global thresholds (the same for every sequence; chosen on synthetic and benchmark data)."""
 
     track_confidence: float = 0.25  # below this the backend's box is not trusted
+    pixel_weight: float = 1.0  # confidence = backend score x pixel likeness ** this (0: the score alone)
     reacquire_after_frames: int = 3  # low-confidence frames before a search may re-initialise
     reacquire_score: float = 0.75  # template match needed to re-initialise on a found box
     reacquire_margin: float = 0.3  # ... and by how much it must beat the backend's own box
@@ -49,9 +50,10 @@ class SubjectTracker:
     after ``lost_after_frames`` misses it reports ``LOST`` and holds the last box.
     """
 
-    def __init__(self, name: str, backend: TrackingBackend,
-                 detector: Detector | None = None, settings: TrackerSettings | None = None) -> None:
+    def __init__(self, name: str, backend: TrackingBackend, detector: Detector | None = None,
+                 settings: TrackerSettings | None = None, model: str | None = None) -> None:
         self.name = name
+        self.model = model  # where the backend's model files came from (None: it has none)
         self._backend = backend
         self._detector = detector
         self.settings = settings or TrackerSettings()
@@ -88,7 +90,7 @@ class SubjectTracker:
         box, backend_score = _usable(*self._backend.update(frame))
         patch = cut_patch(frame, box) if box is not None else None
         similarity = self._appearance.similarity(patch) if patch is not None else 0.0
-        confidence = backend_score * similarity
+        confidence = backend_score * similarity ** s.pixel_weight
         if box is not None and confidence >= s.track_confidence:
             return self._accept(frame, box, patch, similarity, confidence, timestamp)
         self._misses += 1

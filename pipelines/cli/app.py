@@ -6,6 +6,7 @@ import argparse
 import importlib
 import logging
 import sys
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -119,6 +120,12 @@ def _add_logging_options(parser: argparse.ArgumentParser, default: object) -> No
     parser.add_argument("--debug", action="store_true", default=default, help="log debug output and show tracebacks")
 
 
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                      line: str | None = None) -> str:
+    """A warning (e.g. the default tracker's model could not be loaded) as one line, like the errors."""
+    return f"gimbaltrack: warning: {message}\n"
+
+
 def main(argv: list[str] | None = None, release: Iterable[int] | None = None) -> int:
     """Parse ``argv`` and run the subcommand; its exit status. ``release``: the signal mask to go
     back to once the handlers are in place, when the caller holds the signals already."""
@@ -126,6 +133,7 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     run = _Run(debug="--debug" in given)  # until parsed: an OSError may come first
     standard_streams()
     quiet_opencv(given)
+    warnings.formatwarning = _one_line_warning
     try:
         status = _run(argv, release, run)
     except SystemExit:  # argparse's --help (0) or usage error (2): its text is flushed here, not at exit

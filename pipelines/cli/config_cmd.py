@@ -6,10 +6,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-import can
-
-from pipelines.cli.bus import SIM_INTERFACE
-from pipelines.cli.common import CliError
+from pipelines.cli.bus import SIM_INTERFACE, python_can_config
 from pipelines.cli.profile import SCHEMA, Key, Profile, profile_path, read_profile
 
 #: The python-can settings that its own configuration (env, can.rc, ~/.canrc) can give.
@@ -76,13 +73,9 @@ def _as_key(value: Any, key: Key) -> Any:
 
 
 def _python_can_config() -> dict[str, Any]:
-    """What python-can's own configuration sets (env, can.rc, ~/.canrc), without opening a bus."""
-    try:
-        config = can.util.load_config()
-    except can.CanInterfaceNotImplementedError:  # no source names an interface: nothing configured
-        return {}
-    except (ValueError, OSError) as exc:
-        raise CliError(f"python-can's configuration cannot be read: {exc}") from None
+    """What python-can's own configuration sets (env, can.rc, ~/.canrc), without opening a bus; a
+    broken one is the same one-line error a bus command gives."""
+    config = python_can_config({}) or {}
     return {key: config.get(key) for key in PYTHON_CAN_KEYS}
 
 

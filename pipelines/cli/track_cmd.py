@@ -3,8 +3,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import socket
 import sys
-from contextlib import ExitStack
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -14,9 +16,11 @@ from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
 from gimbal.signals import SignalExit, deferred_signals
 from gimbal.values import shown
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
+from pipelines.cli.batch_options import add_batch_options, batch_jobs
 from pipelines.cli.bus import choose_track_bus, open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
+from pipelines.cli.track_batch import run_track_batch
 from pipelines.control import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
 from pipelines.outputs.can_log import CanLogWriter
@@ -24,6 +28,7 @@ from pipelines.sources import FrameSource, SourceError, open_source
 from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
 from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
+from tracker.registry import DEFAULT_MODEL_TRACKER
 
 DEFAULT_DETECTOR = "motion"
 FPS_RANGE = (0.1, 1000.0)  # a frame every 10 s to 1000 a second; the video writer takes these
@@ -41,13 +46,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog="examples:\n  gimbaltrack track samples/demo.mp4 --roi 138,152,64,96\n"
         "  gimbaltrack track 0 --detect face -i socketcan -c can0 --record\n"
         "  gimbaltrack track udp://127.0.0.1:5000 --detect person\n"
-        "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n\n"
-        "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png\n"
+        "  gimbaltrack track clip.mp4 --detect face --realtime   (a file at its own frame rate)\n"
+        "  gimbaltrack track a.mp4 b.mp4 c.mp4 --jobs 2 --out out/batch   (out/batch/a/, out/batch/b/, ...)\n\n"
+        "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png; with several\n"
+        "  SOURCEs, each in --out/<its name>/, each run against its own simulated gimbal (not on a real bus),\n"
+        "  their reports in the order given; the exit status is the worst of theirs\n"
         "exit status: 0 done; 1 the gimbal, bus, source or an output failed mid-run; 2 bad input;\n"
         "  130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to stop in every case)",
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("source", help="video file, image folder, camera index (e.g. 0) or stream URL "
-                        "(udp://, rtsp://, http://)")
+    parser.add_argument("source", nargs="+", metavar="SOURCE", help="video file, image folder, camera index "
+                        "(e.g. 0) or stream URL (udp://, rtsp://, http://); several: see below")
     subject = parser.add_argument_group("subject (default: --detect motion, the largest moving thing)")
     start = subject.add_mutually_exclusive_group()
     start.add_argument("--roi", help="x,y,w,h of the subject in the first frame, in pixels (over an edge: "
@@ -58,10 +66,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
-                         "is nanotrack when --model-dir holds its files, else dcf)")
+                         f"is {DEFAULT_MODEL_TRACKER} on the model files shipped with gimbaltrack, else dcf)")
     subject.add_argument("--model-dir", type=existing_dir,
-                         help="folder with optional model files: NanoTrack (then the default tracker) and "
-                         "YuNet (then the face detector)")
+                         help="folder with optional model files: NanoTrack v3 (instead of the shipped ones), "
+                         "NanoTrack v2, VitTrack, FEAR-XS and YuNet (then the face detector)")
     control = parser.add_argument_group("control")
     control.add_argument("--controller", choices=controller_names(), default="pid",
                          help="pid: world-frame Kalman + PID + feed-forward (default); p: proportional baseline")
@@ -98,11 +106,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--video-width", type=int, default=DEFAULT_VIDEO_WIDTH, metavar="PX",
                      help=f"shrink the annotated video to at most this width (default: {DEFAULT_VIDEO_WIDTH}, "
                      "cheap to encode; 0: the source's full size)")
+    run.add_argument("--console", metavar="[HOST:]PORT",
+                     help="serve the operator console (live view, status, pick the subject, pause, record, "
+                     "stop) on this port, on 127.0.0.1 unless a host is given (any other host needs a token; "
+                     "the URL is printed on stderr at start)")
+    run.add_argument("--console-token", metavar="TOKEN",
+                     help="the console's token (default: one is generated when the host is not loopback)")
     run.add_argument("--quiet", action="store_true", help="no progress line, and no line naming the bus "
                      "chosen without -i (the summary names it)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_bus_options(parser, fallback="the built-in simulated gimbal")
     add_legacy_order_option(parser)
+    add_batch_options(parser, "inputs")
     parser.set_defaults(func=run_track)
 
 
@@ -141,7 +156,12 @@ def _options(args: argparse.Namespace) -> TrackOptions:
 def run_track(args: argparse.Namespace) -> int:
     # main() turns SIGTERM, SIGHUP and SIGQUIT into SignalExit: every ``with`` below stops the
     # gimbal on the way out, and _run finalises the outputs first
-    return _open_and_run(_options(args), args)
+    options = _options(args)  # checked once for all the inputs
+    batch_jobs(args)  # --jobs and --scheduler too, though one input runs here
+    if len(args.source) > 1:
+        return run_track_batch(args, run_track)
+    [args.source] = args.source
+    return _open_and_run(options, args)
 
 
 def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
@@ -163,7 +183,7 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
         except (ValueError, OSError) as exc:
             raise CliError(str(exc)) from None
         where, chosen = choose_track_bus(args)
-        with open_host_bus(args) as bus, ExitStack() as held:
+        with _console_socket(args) as console, open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
             pending_signals = held.enter_context(deferred_signals())
@@ -179,9 +199,41 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                         raise
                     if chosen and not args.quiet:  # once the gimbal answered: an error before names the bus
                         print(chosen, file=sys.stderr, flush=True)
-                    return _run(session, args)
+                    if console is None:
+                        return _run(session, args)
+                    from pipelines.console.track import serving
+                    with serving(session, *console, args.console_token):
+                        return _run(session, args)
             finally:
                 can_log.stop()
+
+
+@contextmanager
+def _console_socket(args: argparse.Namespace) -> Iterator[tuple[Any, socket.socket] | None]:
+    """The console's address and its listening socket, bound before anything is created (a port
+    in use is bad input); None without ``--console``."""
+    if args.console is None:
+        if args.console_token is not None:
+            raise CliError("--console-token needs --console")
+        yield None
+        return
+    try:
+        from pipelines.console.address import bind, parse_console_address
+    except ImportError as exc:
+        raise CliError(f"--console needs aiohttp ({exc}): pip install 'gimbaltrack[console]'") from None
+    try:
+        address = parse_console_address(args.console)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    if args.console_token is not None and len(args.console_token) < 8:
+        raise CliError("--console-token must be at least 8 characters")
+    try:
+        sock = bind(address)
+    except OSError as exc:
+        raise CliError(f"cannot serve the console on {address.host}:{address.port}: "
+                       f"{exc.strerror or exc}") from None
+    with sock:
+        yield address, sock
 
 
 def _say_waiting(description: str) -> None:

@@ -82,10 +82,14 @@ class RateCommand:
 
 
 class Controller(Protocol):
+    config: ControlConfig
+
     def update(self, estimate: TargetEstimate | None, attitude: tuple[float, float] | None,
                now: float) -> RateCommand: ...
 
     def reset(self) -> None: ...
+
+    def retune(self, config: ControlConfig) -> None: ...
 
 
 def _check_now(last_now: float | None, now: float) -> None:
@@ -157,6 +161,15 @@ class RateController:
         self._ramp_from: tuple[float, float] | None = None
         self._yaw_unwrapped = 0.0
         self._last = RateCommand(0.0, 0.0)
+
+    def retune(self, config: ControlConfig) -> None:
+        """New limits, gains and dead band from the next update on (an operator's live settings),
+        keeping the target's filter and each PID's integral and output, so nothing jumps."""
+        self.config = config
+        for pid in (self._pid_yaw, self._pid_pitch):
+            pid.kp, pid.ki, pid.kd = config.kp, config.ki, config.kd
+            pid.output_limit, pid.integral_limit = config.max_speed_dps, config.integral_limit_dps
+            pid.deadband = config.deadband_deg
 
     def _take_attitude(self, attitude: tuple[float, float] | None, frame_t: float, captured: bool) -> bool:
         """Set the pointing reference: the measured ``attitude`` at ``frame_t``; else, once one was
@@ -360,6 +373,18 @@ class ProportionalController:
         self._pid_yaw, self._pid_pitch = self._pid(), self._pid()
         self._last_now: float | None = None
         self._last = RateCommand(0.0, 0.0)
+
+    def retune(self, config: ControlConfig) -> None:
+        """New speed and acceleration limits from the next update on; the baseline's gain is its
+        own (``gain_per_s``), so a config whose PID gains or dead band differ is refused."""
+        fixed = [n for n in ("kp", "ki", "kd", "deadband_deg") if getattr(config, n) != getattr(self.config, n)]
+        if fixed:
+            raise ValueError(f"the p controller has a fixed gain and no dead band: {', '.join(fixed)} "
+                             "apply to the pid controller only")
+        self.config = config
+        for pid in (self._pid_yaw, self._pid_pitch):
+            pid.output_limit = min(config.max_speed_dps, PROTOCOL_MAX_SPEED_DPS)
+            pid.slew_rate = config.max_accel_dps2
 
     def update(self, estimate: TargetEstimate | None, attitude: tuple[float, float] | None,
                now: float) -> RateCommand:

@@ -7,6 +7,7 @@ push message, the keep-alive's setpoint age, the command range), so the rest of
 """
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -59,6 +60,7 @@ class GimbalLink:
         self.signs = signs
         self.history = history if history is not None else AttitudeHistory()
         self._streamer: SpeedStreamer | None = None
+        self._paused: list[SpeedStreamer] = []  # keep-alives stopped by ``pause``: their counts stay
 
     def start(self, wait_s: float | None = None) -> None:
         """Record the attitude push and enable it (``wait_s``: wait that long for the first one,
@@ -100,16 +102,39 @@ class GimbalLink:
         if self._streamer is not None:
             self._streamer.stop()
 
+    def pause(self) -> None:
+        """The keep-alive's stop (zero speed, then release): the gimbal holds until ``resume``."""
+        if self._streamer is None:
+            raise RuntimeError("GimbalLink.pause before start()")
+        self._streamer.stop()
+        self._paused.append(self._streamer)
+
+    def resume(self) -> None:
+        """A new keep-alive after ``pause`` (the old one's counts and latencies are kept)."""
+        self._streamer = self.client.speed_streamer(rate_hz=self.rate_hz)
+
+    def recenter(self) -> None:
+        """The protocol's recenter (send it paused: a speed command would take over again)."""
+        self.client.recenter()
+
+    def _streamers(self) -> list[SpeedStreamer]:
+        """Every keep-alive of the run: those ``pause`` stopped, then the current one."""
+        current = self._streamer is not None and all(s is not self._streamer for s in self._paused)
+        return [*self._paused, self._streamer] if current else list(self._paused)
+
     @property
     def started(self) -> bool:
         return self._streamer is not None
 
     def latencies(self) -> list[float]:
         """Seconds from each setpoint's frame to its first send on the bus."""
-        return self._streamer.latencies() if self._streamer is not None else []
+        return [latency for streamer in self._streamers() for latency in streamer.latencies()]
 
     def stats(self) -> Mapping[str, int]:
         """The keep-alive's counts and the client's safety-stop counts."""
-        counts = dict(self._streamer.stats) if self._streamer is not None else {}
+        summed: Counter[str] = Counter()
+        for streamer in self._streamers():
+            summed.update(streamer.stats)
+        counts = dict(summed)
         counts.update({k: v for k, v in self.client.stats.items() if k.startswith("stop_")})
         return counts

@@ -13,12 +13,13 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
-from pipelines.loop.record import FrameRecord
+from pipelines.control.controller import RateCommand
+from pipelines.loop.record import PAUSED, FrameRecord
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from pipelines.control.controller import Controller
+    from pipelines.control.controller import ControlConfig, Controller
     from pipelines.control.gimbal_link import GimbalLink
     from pipelines.loop.recording import Recorder
     from pipelines.loop.sinks import Sink
@@ -28,6 +29,7 @@ if TYPE_CHECKING:
     from tracker.estimate import TargetEstimate
 
 T = TypeVar("T")
+Note = dict[str, Any]
 
 #: What ``Loop.stop`` records as the reason when the operator gives none.
 OPERATOR_STOP = "stopped by the operator"
@@ -73,7 +75,8 @@ class Loop:
         self.started = clock()
         self.first_acquired_s: float | None = None  # from the loop's start
         self.stop_reason: str | None = None  # set by ``stop``: the driver ends the run after this step
-        self._work: queue.SimpleQueue[tuple[Future[Any], Callable[[], Any]]] = queue.SimpleQueue()
+        self.paused = False  # set by ``pause``: no command is sent until ``resume``
+        self._work: queue.SimpleQueue[tuple[Future[Any], Callable[[], Any], Note | None]] = queue.SimpleQueue()
 
     # -- wiring --------------------------------------------------------------------------
     def attach(self, sink: Sink) -> Sink:
@@ -81,10 +84,12 @@ class Loop:
         self.sinks.append(sink)
         return sink
 
-    def submit(self, fn: Callable[[], T]) -> Future[T]:
-        """Run ``fn`` on the loop's thread at the start of the next step; safe from any thread."""
+    def submit(self, fn: Callable[[], T], note: Note | None = None) -> Future[T]:
+        """Run ``fn`` on the loop's thread at the start of the next step; safe from any thread.
+        ``note`` (what an operator did, JSON-ready) goes into that step's record, with the
+        ``error`` if ``fn`` raised."""
         future: Future[T] = Future()
-        self._work.put((future, fn))
+        self._work.put((future, fn, note))
         return future
 
     # -- what an operator does (on the loop's thread: call them through ``submit``) ------
@@ -102,6 +107,29 @@ class Loop:
         """End the run after the current step (the driver stops the gimbal and finalises)."""
         self.stop_reason = reason
 
+    def pause(self) -> None:
+        """Zero speed, then release: the gimbal holds where it is. Frames go on being tracked;
+        no command is sent until ``resume`` (the state reads ``paused``)."""
+        if not self.paused:
+            self.paused = True
+            self.gimbal.pause()
+
+    def resume(self) -> None:
+        """Follow again after ``pause``: the controller starts from rest on a new keep-alive."""
+        if self.paused:
+            self.controller.reset()
+            self.gimbal.resume()
+            self.paused = False
+
+    def recenter(self) -> None:
+        """Pause, then send the gimbal home (the protocol's recenter); ``resume`` to follow again."""
+        self.pause()
+        self.gimbal.recenter()
+
+    def retune(self, config: ControlConfig) -> None:
+        """New limits, gains and dead band from this step on (an operator's live settings)."""
+        self.controller.retune(config)
+
     def _recorder(self) -> Recorder:
         if self.recorder is None:
             raise RuntimeError("this loop has no camera to record with")
@@ -111,11 +139,14 @@ class Loop:
     def step(self, frame: Frame, t: float) -> FrameRecord:
         """One frame captured at ``t``: submitted work, track, control, stream the setpoint, then
         the record to every sink."""
-        self._run_submitted()
+        notes = self._run_submitted()
         estimate = self.subject.estimate(frame.image, t)
-        attitude = self.gimbal.attitude_at(t) if self.feedback else (0.0, 0.0)
-        command = self.controller.update(estimate, attitude, self.clock())
-        self.gimbal.send(command, stamp=t)
+        if self.paused:  # the gimbal holds: the keep-alive is stopped, nothing is sent
+            command = RateCommand(0.0, 0.0, stamp=t, mode=PAUSED)
+        else:
+            attitude = self.gimbal.attitude_at(t) if self.feedback else (0.0, 0.0)
+            command = self.controller.update(estimate, attitude, self.clock())
+            self.gimbal.send(command, stamp=t)
         if estimate is not None and estimate.found and self.first_acquired_s is None:
             self.first_acquired_s = self.clock() - self.started
             if self.recorder is not None:
@@ -125,29 +156,34 @@ class Loop:
             t_video=None if self.video_fps is None else frame.index / self.video_fps,
             estimate=estimate, command=command, attitude=self.gimbal.latest(), dropped=self.dropped(),
             recording=self.recorder is not None and self.recorder.active,
-            candidates=self.subject.candidates)
+            candidates=self.subject.candidates, paused=self.paused, operator=notes)
         for sink in self.sinks:
             sink.on_frame(record, frame)
         return record
 
-    def _run_submitted(self) -> None:
-        """The submitted work, in order; an exception goes to its ``Future``, not into the loop."""
+    def _run_submitted(self) -> tuple[Note, ...]:
+        """The submitted work, in order; an exception goes to its ``Future`` (and its note), not
+        into the loop. The notes of the work that ran."""
+        notes: list[Note] = []
         while True:
             try:
-                future, fn = self._work.get_nowait()
+                future, fn, note = self._work.get_nowait()
             except queue.Empty:
-                return
+                return tuple(notes)
             if future.set_running_or_notify_cancel():
                 try:
                     future.set_result(fn())
                 except Exception as exc:  # noqa: BLE001 (handed to the submitter)
                     future.set_exception(exc)
+                    note = None if note is None else {**note, "error": str(exc)}
+                if note is not None:
+                    notes.append(note)
 
     def cancel_submitted(self) -> None:
         """Cancel the work that will not run now (the run ended): no submitter is left waiting."""
         while True:
             try:
-                future, _ = self._work.get_nowait()
+                future, _, _ = self._work.get_nowait()
             except queue.Empty:
                 return
             future.cancel()

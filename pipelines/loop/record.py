@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -13,6 +14,8 @@ if TYPE_CHECKING:
 
 #: ``FrameRecord.state`` before the subject is chosen (no estimate yet).
 ACQUIRING = "acquiring"
+#: ``FrameRecord.state`` while an operator has paused the gimbal.
+PAUSED = "paused"
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -32,10 +35,14 @@ class FrameRecord:
     dropped: int  # frames the source has dropped so far
     recording: bool  # the camera was recording (a start was answered and no stop yet)
     candidates: tuple[Detection, ...] = ()  # the detector's candidates of this frame, if it ran
+    paused: bool = False  # an operator paused the gimbal: no command was sent for this frame
+    operator: tuple[dict[str, Any], ...] = ()  # what an operator did at the start of this step
 
     @property
     def state(self) -> str:
-        """``tracking``, ``searching``, ``lost`` or ``acquiring``."""
+        """``tracking``, ``searching``, ``lost`` or ``acquiring``; ``paused`` while paused."""
+        if self.paused:
+            return PAUSED
         return ACQUIRING if self.estimate is None else self.estimate.state.value
 
     @property

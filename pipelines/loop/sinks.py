@@ -42,6 +42,9 @@ def telemetry_record(record: FrameRecord) -> dict[str, Any]:
                  "attitude_deg": None if attitude is None else [attitude.yaw, attitude.pitch, attitude.roll],
                  "attitude_t": None if attitude is None else attitude.timestamp,
                  "dropped": record.dropped})
+    line["state"] = record.state  # paused, whatever the tracker says
+    if record.operator:
+        line["operator"] = list(record.operator)
     return line
 
 

@@ -172,3 +172,11 @@ def test_a_profile_drives_track_with_no_bus_options_on_the_command_line(tmp_path
     assert "udp_multicast" in json.dumps(summary["bus"]) and not (tmp_path / "out" / "annotated.avi").exists()
     ids = Counter(frame.arbitration_id for frame in can.LogReader(str(tmp_path / "out" / "can.log")))
     assert ids[0x323] > 40 and ids[0x322] > 40 and set(ids) == {0x322, 0x323}  # the profile's ids, answered
+
+
+def test_config_names_a_broken_python_can_configuration(capsys: pytest.CaptureFixture[str],
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CAN_CONFIG", "[1]")
+    assert main(["config"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "CAN_CONFIG must be a JSON object" in err

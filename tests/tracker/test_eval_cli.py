@@ -115,7 +115,7 @@ def test_a_truncated_video_is_one_line_naming_the_frame(tmp_path):
     assert captured.stdout == ""
 
 
-@pytest.mark.parametrize("tracker", ["default", "nanotrack", "nano"])
+@pytest.mark.parametrize("tracker", ["nanotrack", "nano"])  # the default reads NanoTrack v3, not these v2 files
 @pytest.mark.parametrize("backbone, head, wrong", [
     (b"junk!", b"junk!", "nanotrack_backbone_sim.onnx: not a readable ONNX network"),
     (fake_onnx.head_bytes(), fake_onnx.backbone_bytes(), "nanotrack_backbone_sim.onnx: not NanoTrack's backbone"),
@@ -178,8 +178,8 @@ def test_one_sequence_and_the_overall_print_the_same_scores(tmp_path):
 
 def test_help_states_defaults_and_examples():
     text = " ".join(gimbaltrack(["eval", "--help"]).stdout.split())
-    assert "(default: default = nanotrack when --model-dir holds its files, else dcf)" in text
-    assert "nanotrack_v2/ (default: none)" in text and "examples: gimbaltrack eval" in text
+    assert "(default: default = nanotrack3 on the model files shipped with gimbaltrack, else dcf)" in text
+    assert "nanotrack_v2/ (default: the files shipped with gimbaltrack)" in text and "examples: gimbaltrack eval" in text
 
 
 def test_sigterm_exits_143_with_a_note(tmp_path):

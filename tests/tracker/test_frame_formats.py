@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from tests import fake_onnx
-from tracker.backends import BACKEND_NAMES, make_backend
+from tracker.backends import BACKEND_NAMES, MODEL_BACKENDS, make_backend
 from tracker.boxes import iou
 from tracker.detectors import DETECTOR_KINDS, Detection, make_detector
 from tracker.estimate import TrackState
@@ -18,7 +18,6 @@ from tracker.registry import make_tracker
 from tracker.synthetic import render_sequence
 
 FORMATS = ("grey", "grey x 1", "bgr", "bgra")
-MODEL_BACKENDS = ("nanotrack", "nano")
 
 
 def _as(frame: np.ndarray, fmt: str) -> np.ndarray:
@@ -30,9 +29,11 @@ def _as(frame: np.ndarray, fmt: str) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def fake_models(tmp_path_factory):
-    """NanoTrack-shaped networks (tests/fake_onnx.py): the backends run without the shared model files."""
+    """Networks shaped like NanoTrack v2 (in nanotrack_v2/), v3, VitTrack and FEAR-XS (tests/fake_onnx.py):
+    the backends run without the shared model files."""
     folder = tmp_path_factory.mktemp("models")
-    return fake_onnx.write_nanotrack_files(folder, fake_onnx.backbone_bytes(), fake_onnx.head_bytes())
+    fake_onnx.write_nanotrack_files(folder / "nanotrack_v2", fake_onnx.backbone_bytes(), fake_onnx.head_bytes())
+    return fake_onnx.onnx_model_files(folder)
 
 
 def _detector(kind: str, request: pytest.FixtureRequest):
