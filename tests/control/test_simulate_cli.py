@@ -63,8 +63,8 @@ def test_frames_without_truth_are_counted_and_left_out(sequence: Path, tmp_path:
 
 def test_model_dir_reaches_the_tracker(sequence: Path, shared_data: Path,
                                         capsys: pytest.CaptureFixture[str]) -> None:
-    code, stdout, _ = simulate([str(sequence), "--fps", "60", "--json", "--model-dir", str(shared_data / "models")],
-                               capsys)
+    code, stdout, _ = simulate([str(sequence), "--fps", "60", "--json", "--tracker", "nanotrack", "--model-dir",
+                                str(shared_data / "models")], capsys)
     assert code == 0 and json.loads(stdout)["tracker"] == "nanotrack"
 
 
@@ -129,7 +129,8 @@ def test_a_read_only_output_folder_fails_before_the_run(sequence: Path, tmp_path
 def test_wrong_model_files_are_named_in_one_line(backbone: bytes, head: bytes, wrong: str, sequence: Path,
                                                  tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     models = fake_onnx.write_nanotrack_files(tmp_path / "models", backbone, head)  # once a cv2.error traceback
-    code, stdout, err = simulate([str(sequence), "--fps", "60", "--model-dir", str(models)], capsys)
+    code, stdout, err = simulate([str(sequence), "--fps", "60", "--tracker", "nanotrack", "--model-dir", str(models)],
+                                 capsys)
     assert code == 2 and stdout == ""
     assert err.startswith("gimbaltrack simulate: error: NanoTrack") and wrong in err and err.count("\n") == 1
 
@@ -139,7 +140,7 @@ def test_help_lists_trackers_defaults_and_examples(capsys: pytest.CaptureFixture
         main(["simulate", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "oracle" in text and "dcf" in text and "csrt" in text
-    assert "(default: default = nanotrack when --model-dir holds its files, else dcf)" in text
+    assert "(default: default = nanotrack3 on the model files shipped with gimbaltrack, else dcf)" in text
     assert "(default: none, nothing is written)" in text
     assert "examples: gimbaltrack simulate" in text
 
