@@ -13,18 +13,20 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from collections.abc import Iterator, Sequence as Seq
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gimbal.client import GimbalClient
 from gimbal.sim import SimConfig, start_in_process
+from gimbal.sim.model import GimbalModel
 from pipelines.control.controller import ControlConfig, Controller, RateCommand, make_controller
 from pipelines.control.gimbal_link import GimbalLink
 from pipelines.control.metrics import CentringSample, summarize
-from pipelines.loop import Loop
+from pipelines.loop import Loop, Sink
 from pipelines.sources import Frame
 from pipelines.virtual_camera import VirtualCamera
 from tracker import SubjectTracker, make_tracker
@@ -34,6 +36,9 @@ from tracker.detectors import Detection
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.evaluation import first_box
 from tracker.metrics import has_truth
+
+if TYPE_CHECKING:
+    import can
 
 ORACLE = "oracle"
 SIM_CONFIG = SimConfig(yaw_continuous=True)  # the simulated gimbal the loop turns
@@ -49,6 +54,7 @@ class LoopSettings:
     fps: float = 30.0
     control: ControlConfig = ControlConfig()
     model_dir: Path | None = None  # the tracker's model files (e.g. NanoTrack's), as make_tracker takes them
+    max_frames: int | None = None  # stop after this many frames (None: the whole sequence)
 
 
 @dataclass(frozen=True)
@@ -156,6 +162,18 @@ def _check_truth(seq: Sequence, tracked: bool) -> None:
         first_box(seq)
 
 
+def start_pointing(vc: VirtualCamera, seq: Sequence, config: SimConfig = SIM_CONFIG) -> SimConfig:
+    """``config`` with the gimbal's start pose turned to centre the first ground-truth box in the
+    view (pitch held within the simulated gimbal's range), so a subject that starts away from the
+    wide frame's centre is in view at the first frame instead of out of it."""
+    box = next(box for box in seq.groundtruth if has_truth(box))
+    yaw, pitch = vc.source.pixel_to_angles(*center(box))
+    pitch_range = GimbalModel(config, now=0.0).axis_range("pitch")
+    _, roll, _ = config.initial_joint_deg
+    pitch = min(max(pitch, pitch_range.low), pitch_range.high)
+    return replace(config, initial_joint_deg=(yaw - config.base_yaw_deg, roll, pitch))
+
+
 @dataclass
 class PreparedLoop:
     """A sequence loaded and checked, its first frame read, and the view, controller and tracker
@@ -169,6 +187,8 @@ class PreparedLoop:
     vc: VirtualCamera
     controller: Controller
     subject: SubjectTracker | None  # None: the oracle
+    sim_config: SimConfig  # the simulated gimbal, pointed at the first ground-truth box
+    samples: dict[int, CentringSample | None] = field(default_factory=dict)  # by frame index, as the run goes
 
 
 def prepare_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> PreparedLoop:
@@ -181,13 +201,14 @@ def prepare_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) 
     vc = VirtualCamera((first.shape[1], first.shape[0]), settings.out_size, settings.hfov_deg)
     controller = make_controller(settings.controller, camera=vc.camera, config=settings.control)
     subject = None if settings.tracker == ORACLE else make_tracker(settings.tracker, settings.model_dir)
+    sim_config = start_pointing(vc, seq)
     if subject is not None:  # the tracker starts on the first view, taken at the gimbal's start pose
-        joint_yaw, _, pitch = SIM_CONFIG.initial_joint_deg
-        view_box = vc.box_to_view(first_box(seq), joint_yaw + SIM_CONFIG.base_yaw_deg, pitch)
+        joint_yaw, _, pitch = sim_config.initial_joint_deg
+        view_box = vc.box_to_view(first_box(seq), joint_yaw + sim_config.base_yaw_deg, pitch)
         if view_box is None:
             raise ValueError(f"{seq.name}: the first ground-truth box is behind the view")
         start_box(view_box, *settings.out_size)
-    return PreparedLoop(settings, seq, frames, first, vc, controller, subject)
+    return PreparedLoop(settings, seq, frames, first, vc, controller, subject, sim_config)
 
 
 def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings()) -> LoopResult:
@@ -195,24 +216,28 @@ def run_closed_loop(sequence: str | Path, settings: LoopSettings = LoopSettings(
     return run_prepared(prepare_loop(sequence, settings))
 
 
-def run_prepared(loop: PreparedLoop) -> LoopResult:
-    """Run a prepared loop; see the module doc."""
+def run_prepared(loop: PreparedLoop, sinks: Seq[Sink] = (), listeners: Seq[can.Listener] = ()) -> LoopResult:
+    """Run a prepared loop; see the module doc. ``sinks`` get every frame's record and view (and
+    are closed however the run ends), ``listeners`` every CAN frame both ways (e.g. a CAN log)."""
     settings, seq, frames, first, vc = loop.settings, loop.seq, loop.frames, loop.first, loop.vc
     subject = SimulatedSubject(OracleTracker(vc.camera.width, vc.camera.height), loop.subject)
 
-    host_bus, sim = start_in_process(SIM_CONFIG)
+    host_bus, sim = start_in_process(loop.sim_config)
     steps: list[LoopStep] = []
     try:
-        with GimbalClient(host_bus) as client:
+        with GimbalClient(host_bus, listeners=list(listeners)) as client:
             link = GimbalLink(client)
             link.start(wait_s=1.0)
             closed = Loop(subject, loop.controller, link)
+            for sink in sinks:
+                closed.attach(sink)
             pending: deque[_Captured] = deque()
             t0 = time.monotonic() + 0.05
             truth = iter(seq.groundtruth)
 
             def process(item: _Captured) -> None:
                 subject.truth, subject.index = item.box, item.index
+                loop.samples[item.index] = item.sample
                 record = closed.step(Frame(item.view, item.t, item.index), item.t)
                 steps.append(LoopStep(item.t - t0, item.sample, record.command))
 
@@ -231,11 +256,13 @@ def run_prepared(loop: PreparedLoop) -> LoopResult:
                 box, sample = _truth_in_view(vc, next(truth), yaw, pitch, t_cap - t0)
                 pending.append(_Captured(t_cap + settings.latency_s, t_cap, index, view, box, sample))
                 index += 1
-                frame = next(frames, None)
+                frame = next(frames, None) if settings.max_frames is None or index < settings.max_frames else None
             link.stop()
             latencies = link.latencies()
     finally:
         sim.stop()
         host_bus.shutdown()
+        for sink in sinks:
+            sink.close()
     used = replace(settings, tracker=subject.name, hfov_deg=vc.camera.hfov_deg)
     return LoopResult(used, steps, summarize([s.sample for s in steps]), latencies)

@@ -20,7 +20,9 @@ from pipelines.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartCon
 from pipelines.control import CameraModel, ControlConfig, make_controller
 from pipelines.control.gimbal_link import GimbalLink, Signs
 from pipelines.control.tuning import settings_of
-from pipelines.loop import Loop, PlotSink, ProgressSink, Recorder, SummarySink, TelemetrySink, VideoSink
+from pipelines.loop import (
+    Loop, PlotSink, ProgressSink, Recorder, SummarySink, TelemetrySink, VideoSink, loop_panels,
+)
 from pipelines.loop.link import LinkNotices, LinkSink, link_health
 from pipelines.loop.record import FrameRecord
 from pipelines.outputs.latency import latency_percentiles
@@ -149,7 +151,7 @@ class TrackSession:
         self.outputs = [self.loop.attach(TelemetrySink(self.paths["telemetry"]))]
         self.counts = SummarySink(lambda sync: self.write_summary(sync), SUMMARY_EVERY_S)
         self.loop.attach(self.counts)
-        self.plot = self.loop.attach(PlotSink(self.paths["plot"]))
+        self.plot = self.loop.attach(PlotSink(self.paths["plot"], loop_panels(self.feedback)))
         if options.video:
             self.paths["video"] = out / "annotated.avi"
             self.outputs.append(self.loop.attach(VideoSink(self.paths["video"], source.size, source.playback_fps,
@@ -249,7 +251,7 @@ class TrackSession:
             "status": self.reason, "error": self.error,
             "source": self.source.description, "live": self.source.is_live,
             "bus": self.bus_description, "tracker": self.subject.name, "controller": self.options.controller,
-            "attitude_feedback": self.feedback,
+            "attitude_feedback": self.feedback, "loop": "closed" if self.feedback else "open",
             "frames": counts.frames, "elapsed_s": elapsed, "fps": counts.frames / elapsed if elapsed > 0 else None,
             "frames_dropped": counts.dropped,
             "frames_expected": None if self.source.is_live else self.source.frame_count,

@@ -1,8 +1,11 @@
-"""Make the demo clip: a face-like figure moving over a drifting textured scene, passing behind a post.
+"""Make the demo clips: a face-like figure moving over a drifting textured scene, passing behind a
+post (demo.mp4, 640x360), and the same figure crossing a still, wide scene (demo_wide.mp4, 1280x720,
+the closed-loop demo's: a virtual camera on the simulated gimbal looks into it).
 
-Everything is drawn here from a fixed seed, so the clip and its ground truth are reproducible:
+Everything is drawn here from fixed seeds, so the clips and their ground truth are reproducible:
 
-    .venv/bin/python samples/make_demo_clip.py        # writes demo.mp4, demo_groundtruth.txt, demo_roi.txt
+    .venv/bin/python samples/make_demo_clip.py        # writes demo.mp4, demo_groundtruth.txt, demo_roi.txt,
+                                                      # demo_wide.mp4, demo_wide_groundtruth.txt
 
 The ground truth is OTB style (``x,y,w,h`` per frame, top-left origin, pixels) and always gives the
 subject's full box, also while the post hides it.
@@ -27,11 +30,18 @@ KEYFRAMES = [
     (4.2, 190, 170, 1.10), (5.0, 320, 165, 1.15), (6.0, 520, 200, 1.25), (7.5, 575, 205, 1.40),
     (9.0, 560, 185, 1.50),
 ]
+WIDE_WIDTH, WIDE_HEIGHT, WIDE_SECONDS, WIDE_SEED = 1280, 720, 6.0, 20261127
+# The wide clip's path: from near the left edge (outside the central view a gimbal at rest sees)
+# across the scene and back, at up to about 220 px/s (15 deg/s at the default 73.7 deg lens).
+WIDE_KEYFRAMES = [
+    (0.0, 120, 470, 1.5), (1.2, 330, 430, 1.5), (2.4, 560, 500, 1.5), (3.6, 820, 420, 1.5),
+    (4.8, 1080, 460, 1.5), (6.0, 960, 500, 1.5),
+]
 
 
-def catmull_rom(times: np.ndarray) -> np.ndarray:
-    """Centre x, centre y and scale at ``times`` on a Catmull-Rom spline through ``KEYFRAMES``."""
-    keys = np.array(KEYFRAMES, dtype=float)
+def catmull_rom(times: np.ndarray, keyframes: list[tuple[float, ...]] = KEYFRAMES) -> np.ndarray:
+    """Centre x, centre y and scale at ``times`` on a Catmull-Rom spline through ``keyframes``."""
+    keys = np.array(keyframes, dtype=float)
     padded = np.vstack([keys[0], keys, keys[-1]])
     out = np.empty((len(times), 3))
     for n, t in enumerate(times):
@@ -43,24 +53,26 @@ def catmull_rom(times: np.ndarray) -> np.ndarray:
     return out
 
 
-def make_background(rng: np.random.Generator) -> np.ndarray:
-    """A scene larger than the frame: soft colour noise, a skyline of windowed blocks, paving stripes."""
-    h, w = HEIGHT + 2 * DRIFT, WIDTH + 2 * DRIFT
+def make_background(rng: np.random.Generator, scale: int = 1) -> np.ndarray:
+    """A scene larger than the frame: soft colour noise, a skyline of windowed blocks, paving stripes;
+    ``scale`` times the 640x360 clip's scene in each direction (more blocks, same sizes)."""
+    h, w = (HEIGHT + 2 * DRIFT) * scale, (WIDTH + 2 * DRIFT) * scale
+    ground = 260 * scale
     noise = rng.uniform(0, 1, (9, 16, 3)).astype(np.float32)
     scene = cv2.resize(noise, (w, h), interpolation=cv2.INTER_CUBIC)
     scene = (np.clip(scene, 0, 1) * 70 + np.array([110, 120, 95], np.float32)).astype(np.uint8)
-    for _ in range(14):
+    for _ in range(14 * scale * scale):
         bx, bw = int(rng.integers(0, w - 40)), int(rng.integers(40, 110))
-        top = int(rng.integers(30, 170))
+        top = int(rng.integers(30, ground - 90))
         shade = tuple(int(c) for c in rng.integers(60, 170, 3))
-        cv2.rectangle(scene, (bx, top), (bx + bw, 260), shade, cv2.FILLED)
-        for wy in range(top + 8, 250, 18):
+        cv2.rectangle(scene, (bx, top), (bx + bw, ground), shade, cv2.FILLED)
+        for wy in range(top + 8, ground - 10, 18):
             for wx in range(bx + 6, bx + bw - 10, 16):
                 lit = tuple(int(c) for c in rng.integers(150, 255, 3)) if rng.random() < 0.5 else (40, 40, 50)
                 cv2.rectangle(scene, (wx, wy), (wx + 8, wy + 10), lit, cv2.FILLED)
-    cv2.rectangle(scene, (0, 260), (w, h), (90, 100, 105), cv2.FILLED)
-    for k in range(-10, 30):
-        cv2.line(scene, (k * 40, h), (k * 40 + 120, 260), (120, 130, 135), 2, cv2.LINE_AA)
+    cv2.rectangle(scene, (0, ground), (w, h), (90, 100, 105), cv2.FILLED)
+    for k in range(-10, 30 * scale):
+        cv2.line(scene, (k * 40, h), (k * 40 + 120 * scale, ground), (120, 130, 135), 2, cv2.LINE_AA)
     return cv2.GaussianBlur(scene, (3, 3), 0)
 
 
@@ -148,6 +160,32 @@ def render(out_dir: Path) -> list[tuple[float, float, float, float]]:
     return boxes
 
 
+def render_wide(out_dir: Path) -> list[tuple[float, float, float, float]]:
+    """Write demo_wide.mp4 and demo_wide_groundtruth.txt into ``out_dir``; return the boxes. The
+    scene stands still (a fixed wide camera), so the clip compresses well."""
+    rng = np.random.default_rng(WIDE_SEED)
+    scene = make_background(rng, scale=2)
+    top, left = (scene.shape[0] - WIDE_HEIGHT) // 2, (scene.shape[1] - WIDE_WIDTH) // 2
+    background = scene[top:top + WIDE_HEIGHT, left:left + WIDE_WIDTH]
+    sprite, mask = make_sprite()
+    times = np.arange(int(WIDE_SECONDS * FPS)) / FPS
+    writer = cv2.VideoWriter(str(out_dir / "demo_wide.mp4"), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*"mp4v"),
+                             FPS, (WIDE_WIDTH, WIDE_HEIGHT))
+    if not writer.isOpened():
+        raise SystemExit("cannot write demo_wide.mp4")
+    boxes = []
+    try:
+        for cx, cy, scale in catmull_rom(times, WIDE_KEYFRAMES):
+            frame = background.copy()
+            boxes.append(paste_sprite(frame, sprite, mask, cx, cy, scale))
+            writer.write(frame)
+    finally:
+        writer.release()
+    lines = [",".join(f"{v:.1f}" for v in box) for box in boxes]
+    (out_dir / "demo_wide_groundtruth.txt").write_text("\n".join(lines) + "\n")
+    return boxes
+
+
 def report_occlusion(hidden: np.ndarray) -> None:
     """Print the occluded frame ranges and check the subject goes behind the post exactly once."""
     partly = np.flatnonzero(hidden > 0)
@@ -161,7 +199,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent,
                         help="folder to write into (default: this folder)")
-    render(parser.parse_args().out)
+    out = parser.parse_args().out
+    render(out)
+    render_wide(out)
 
 
 if __name__ == "__main__":

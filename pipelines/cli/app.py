@@ -26,6 +26,7 @@ SUBCOMMAND_MODULES = [
     "pipelines.cli.gimbal_cmd",
     "pipelines.cli.simulate_cmd",
     "pipelines.cli.config_cmd",
+    "pipelines.cli.doctor_cmd",
 ]
 #: Each command's line in ``gimbaltrack --help``, as its module registers it (a test checks they
 #: agree): the list is shown without importing the modules, which load OpenCV and SciPy.
@@ -38,6 +39,7 @@ COMMAND_HELP = {
     "gimbal": "talk to a DJI RS gimbal: read, move, set, camera",
     "simulate": "run tracker + control + client against the simulated gimbal on a sequence",
     "config": "print the effective settings (rig profile, python-can configuration, defaults)",
+    "doctor": "check a gimbal rig: bus, ids, replies, latency, pushes, another controller",
 }
 
 
@@ -134,6 +136,8 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     standard_streams()
     quiet_opencv(given)
     warnings.formatwarning = _one_line_warning
+    # Said once a run, however many trackers it makes (eval makes one to check the name, then one a sequence).
+    warnings.filterwarnings("once", message="the default tracker's model")
     try:
         status = _run(argv, release, run)
     except SystemExit:  # argparse's --help (0) or usage error (2): its text is flushed here, not at exit

@@ -8,10 +8,11 @@ import math
 import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, prepare_loop, run_prepared
+from pipelines.closed_loop import ORACLE, LoopResult, LoopSettings, PreparedLoop, prepare_loop, run_prepared
 from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
 from pipelines.control.controller import controller_names
 from pipelines.control.metrics import MAX_ERROR, OVERSHOOT_WINDOW_S
@@ -19,6 +20,9 @@ from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
 from pipelines.progress import ProgressReporter
 from tracker.registry import DEFAULT_BACKEND, DEFAULT_MODEL_TRACKER, available_trackers
+
+if TYPE_CHECKING:
+    from pipelines.loop import FrameRecord
 
 
 MAX_LATENCY_MS = 2000.0  # far beyond any pipeline worth simulating; a typo must not sleep for hours
@@ -35,7 +39,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "(NaN or empty boxes) are left out of the scores and are no detection for --tracker oracle.",
         epilog="examples:\n  gimbaltrack simulate ../shared/data/sequences/vot15_ball1\n"
         "  gimbaltrack simulate ../shared/data/sequences/vot15_ball1 --tracker oracle --latency 100 --out /tmp/sim\n"
-        "  gimbaltrack simulate samples/demo.mp4 --controller p --json",
+        "  gimbaltrack simulate samples/demo_wide.mp4 --out out/demo   (what scripts/demo.sh runs)\n\n"
+        "outputs in --out: annotated.avi (the view), telemetry.jsonl, can.log, summary.json, plot.png",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("sequence", metavar="SEQ_DIR", help="sequence folder or video with ground truth")
     parser.add_argument("--fov", type=float, metavar="DEG",
@@ -56,10 +61,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
                         "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: the files shipped with gimbaltrack)")
     parser.add_argument("--fps", type=float, default=30.0, help="playback frame rate (default 30)")
+    parser.add_argument("--max-frames", type=int, metavar="N", help="stop after N frames (default: all)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of text")
     parser.add_argument("--quiet", action="store_true", help="no progress line (shown on a terminal only)")
     parser.add_argument("--out", type=out_dir, metavar="DIR",
-                        help="write plot.png and summary.json here (default: none, nothing is written)")
+                        help="write the view's annotated video, telemetry, CAN log, plot.png and summary.json "
+                        "here, as track does (default: none, nothing is written)")
     parser.set_defaults(func=run)
 
 
@@ -102,22 +109,38 @@ def summary_of(result: LoopResult) -> dict[str, object]:
     return {
         **result.summary,
         "controller": s.controller, "tracker": s.tracker, "latency_ms": s.latency_s * 1000.0,
-        "fov_deg": s.hfov_deg, "size": list(s.out_size),
+        "fov_deg": s.hfov_deg, "size": list(s.out_size), "loop": "closed",
         "median_capture_to_bus_ms": None if median is None else median * 1000.0,
     }
 
 
-def write_plot(path: Path, result: LoopResult) -> None:
-    from pipelines.outputs.plot import write_timeseries_png
-    t = [step.t for step in result.steps]
-    write_timeseries_png(
-        path, t,
-        [{"centre error": [math.nan if step.sample is None else step.sample.error for step in result.steps]},
-         {"yaw": [step.command.yaw_dps for step in result.steps],
-          "pitch": [step.command.pitch_dps for step in result.steps]}],
-        titles=[f"centring error ({result.settings.controller}, +{result.settings.latency_s * 1000:.0f} ms)",
-                "commanded rates"],
-        ylabels=["fraction of diagonal", "deg/s"])
+class Outputs:
+    """What ``--out`` gets, of the same kind as ``track``'s: the view's annotated video, telemetry,
+    the CAN log, and plot.png (the angular error and rates, and the centring error against the
+    ground truth) as the run goes; summary.json at the end."""
+
+    def __init__(self, out: Path, loop: PreparedLoop) -> None:
+        from pipelines.loop import Panel, PlotSink, TelemetrySink, VideoSink, loop_panels
+        from pipelines.outputs.can_log import CanLogWriter
+        samples = loop.samples
+
+        def centre_error(record: FrameRecord) -> float:
+            sample = samples.get(record.index)
+            return math.nan if sample is None else sample.error
+
+        self.paths = {name: out / name for name in
+                      ("annotated.avi", "telemetry.jsonl", "can.log", "plot.png", "summary.json")}
+        truth = Panel("centring error against the ground truth", "fraction of diagonal",
+                      {"centre error": centre_error})
+        self.can_log = CanLogWriter(self.paths["can.log"])
+        self.sinks = [TelemetrySink(self.paths["telemetry.jsonl"]),
+                      PlotSink(self.paths["plot.png"], (*loop_panels(True), truth)),
+                      VideoSink(self.paths["annotated.avi"], loop.settings.out_size, loop.settings.fps, None)]
+
+    def stop(self) -> None:
+        self.can_log.stop()
+        if self.can_log.error is not None:
+            raise OSError(self.can_log.error)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -125,37 +148,42 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"--latency takes 0 to {MAX_LATENCY_MS:g} ms and --fps above 0 up to {MAX_FPS:g}")
     if args.fov is not None and not 0 < args.fov < 180:
         raise CliError(f"--fov takes 0 < DEG < 180, not {args.fov:g}")
+    if args.max_frames is not None and args.max_frames < 1:
+        raise CliError("--max-frames must be at least 1")
     if max(args.size) > MAX_SIDE:
         raise CliError(f"--size takes at most {MAX_SIDE} pixels a side, not {args.size[0]}x{args.size[1]}")
     settings = LoopSettings(controller=args.controller, tracker=args.tracker, hfov_deg=args.fov,
                             out_size=args.size, latency_s=args.latency / 1000.0, fps=args.fps,
-                            model_dir=args.model_dir)
+                            model_dir=args.model_dir, max_frames=args.max_frames)
+    outputs = None
     try:
         loop = prepare_loop(args.sequence, settings)  # a bad sequence fails before --out is created
         if args.out:
             make_out_dir(args.out)
-        frames = _CountedFrames(loop.frames, ProgressReporter(len(loop.seq),
+            outputs = Outputs(args.out, loop)  # shares the loop's samples, as the copy below does
+        frames = _CountedFrames(loop.frames, ProgressReporter(min(len(loop.seq), args.max_frames or len(loop.seq)),
                                                               enabled=not args.quiet and sys.stderr.isatty()))
         status = "stopped"
         try:
-            result = run_prepared(dataclasses.replace(loop, frames=frames))
+            result = run_prepared(dataclasses.replace(loop, frames=frames), outputs.sinks if outputs else (),
+                                  [outputs.can_log] if outputs else ())
             status = "done"
         finally:
             frames.close(status)
+            if outputs:
+                outputs.stop()
+        summary = summary_of(result)
+        if outputs:
+            write_summary(outputs.paths["summary.json"], summary)
     except (FileNotFoundError, ValueError) as exc:
         raise CliError(str(exc)) from exc
+    except OSError as exc:  # a full disk, a folder made read-only during the run
+        raise CliError(f"cannot write the results in {args.out}: {exc.strerror or exc}", exit_code=1) from None
     except (KeyboardInterrupt, SystemExit):  # Ctrl-C, or SIGTERM/SIGHUP/SIGQUIT turned into SystemExit
         if args.out:
-            print(f"gimbaltrack simulate: note: stopped before the end, nothing written to {args.out}",
-                  file=sys.stderr)
+            print(f"gimbaltrack simulate: note: stopped before the end; the outputs so far are in {args.out} "
+                  "(no summary.json)", file=sys.stderr)
         raise
-    summary = summary_of(result)
-    if args.out:
-        try:
-            write_plot(args.out / "plot.png", result)
-            write_summary(args.out / "summary.json", summary)
-        except OSError as exc:  # a full disk, a folder made read-only during the run
-            raise CliError(f"cannot write the results in {args.out}: {exc.strerror or exc}", exit_code=1) from None
     if args.json:
         print(json.dumps(summary))
         return 0
@@ -171,5 +199,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"time to first centre: {'never' if ttc is None else f'{ttc:.2f} s'}, overshoot "
           f"{summary['overshoot']:.0%} of the initial offset (in the {OVERSHOOT_WINDOW_S:g} s after first centring)")
     if args.out:
-        print(f"wrote {args.out / 'plot.png'} and {args.out / 'summary.json'}")
+        print(f"outputs: {args.out} (annotated.avi, telemetry.jsonl, can.log, plot.png, summary.json)")
     return 0

@@ -4,8 +4,9 @@ from pipelines.loop.loop import OPERATOR_STOP, Loop, Subject
 from pipelines.loop.record import ACQUIRING, FrameRecord
 from pipelines.loop.recording import Recorder
 from pipelines.loop.sinks import (
-    Panel, PlotSink, ProgressSink, Sink, SummarySink, TelemetrySink, VideoSink, telemetry_record,
+    Panel, PlotSink, ProgressSink, Sink, SummarySink, TelemetrySink, VideoSink, loop_panels, telemetry_record,
 )
 
 __all__ = ["ACQUIRING", "OPERATOR_STOP", "FrameRecord", "Loop", "Panel", "PlotSink", "ProgressSink",
-           "Recorder", "Sink", "Subject", "SummarySink", "TelemetrySink", "VideoSink", "telemetry_record"]
+           "Recorder", "Sink", "Subject", "SummarySink", "TelemetrySink", "VideoSink", "loop_panels",
+           "telemetry_record"]

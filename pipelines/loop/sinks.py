@@ -114,6 +114,19 @@ TRACK_PANELS = (
 )
 
 
+#: How the plot and the summary name a run whose picture cannot answer the gimbal (a recording
+#: played against it): the error it shows is not one the gimbal could close.
+OPEN_LOOP = "open loop: the picture does not follow the gimbal"
+CLOSED_LOOP = "closed loop"
+
+
+def loop_panels(closed: bool, panels: Sequence[Panel] = TRACK_PANELS) -> tuple[Panel, ...]:
+    """``panels`` with the first title saying whether the loop is closed, so that an open loop's
+    climbing error is not read as a failure."""
+    first = dataclasses.replace(panels[0], title=f"{panels[0].title} - {CLOSED_LOOP if closed else OPEN_LOOP}")
+    return (first, *panels[1:])
+
+
 class PlotSink:
     """Collects the panels' values, one per frame against ``t_run``; ``close`` draws plot.png
     (nothing when no frame came: a run that ended before its first frame has nothing to plot)."""

@@ -37,6 +37,7 @@ def _run(argv: list[str]) -> dict:
     ["--help"],
     ["gimbal", "move", "--yaw", "3.2", "--roll", "4.8", "--pitch", "6.4", "--absolute", "--time", "2",
      "--seq", "0x1122", "--print-packet"],
+    ["doctor", "--help"],
 ])
 def test_help_and_print_packet_load_neither_opencv_nor_scipy(argv: list[str]) -> None:
     result = _run(argv)

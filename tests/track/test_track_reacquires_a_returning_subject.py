@@ -36,7 +36,9 @@ def test_the_detector_runs_only_without_a_subject_and_finds_it_again(
     monkeypatch.setattr(pipelines.track_session, "make_detector", lambda *a: counted("detect", make_detector(*a)))
     monkeypatch.setattr(pipelines.track_session, "make_tracker", lambda *a: counted("init", make_tracker(*a)))
     clip = make_clip(tmp_path / "back.avi", 90, _position)
-    assert run_track(clip, tmp_path / "out", "--detect", "motion", "--no-video") == 0
+    # dcf: NanoTrack v3, the default, follows the returning subject on the sliver that came into view
+    # first (a known gap of the default, docs/tracker.md); what is tested here is track's detector rule.
+    assert run_track(clip, tmp_path / "out", "--detect", "motion", "--no-video", "--tracker", "dcf") == 0
     records = read_telemetry(tmp_path / "out" / "telemetry.jsonl")
     states = [r["state"] for r in records]
     lost = states.index("lost")
