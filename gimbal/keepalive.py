@@ -6,10 +6,17 @@ reply is checked at the next send (at least half a period later, 20 ms at 25 Hz,
 that arrive within ~5 ms), so a slow or silent gimbal never lowers the send rate. A new setpoint
 is sent at once (if half a period has passed since the last send) instead of waiting for the
 next tick, which keeps the capture-to-command latency low; the schedule restarts from there.
+
+Each command's outcome feeds a ``gimbal.watchdog.BusWatchdog``: a reply in time, a late one (the
+gimbal hears us, slowly), or none within the time one command lasts (unanswered). Missing replies
+never end streaming: after the watchdog's timeout of silence the gimbal is stopped and released
+(``disengaged``), then probed with a release a few times a second; its first answer re-engages
+it, and the latest setpoint streams again.
 """
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from collections import Counter, deque
@@ -22,7 +29,8 @@ import can
 from gimbal.errors import BusError, GimbalError, SendError
 from gimbal.messages import Message, Reply
 from gimbal.messages.limits import MAX_SPEED_DPS, SPEED_COMMAND_LASTS_S
-from gimbal.messages.motion import SPEED_HOLD, SpeedControl, finite_number, to_raw
+from gimbal.messages.motion import SPEED_HOLD, SPEED_RELEASE, SpeedControl, finite_number, to_raw
+from gimbal.watchdog import DISENGAGED, BusWatchdog
 
 if TYPE_CHECKING:
     from gimbal.matcher import PendingReply
@@ -31,7 +39,8 @@ log = logging.getLogger(__name__)
 
 DEFAULT_MAX_AGE_S = 0.3  # a setpoint this old is replaced by zero speed
 STAT_KEYS = ("sent", "zero_sent", "replies", "late_replies", "reply_errors", "reply_timeouts",
-             "send_errors")  # from the start
+             "send_errors", "unanswered", "disengaged", "reengaged", "probes")  # from the start
+PROBE_EVERY_S = 0.2  # while disengaged: a release, to learn when the gimbal answers again
 MIN_RATE_HZ = 2 / SPEED_COMMAND_LASTS_S  # at least two sends inside the time one command lasts
 MAX_RATE_HZ = 50.0  # public drivers use 10-50 Hz; a new setpoint may go out at twice the rate, and
 # each reply (a few ms) must be back by the next send, half a period later at the least
@@ -71,22 +80,23 @@ class SpeedStreamer:
     zero speed goes out instead, so a stalled tracker stops the gimbal. Reply errors, reply
     timeouts and sends the bus refused (a full transmit queue) are counted in ``stats``; so are
     replies that came after their command's window (``late_replies``: a slow link, e.g.
-    ``gimbaltrack sim --delay-ms 150``), which show the gimbal hears us. ``max_missed_replies``
-    consecutive speed commands without a reply, timed out or not sent, and no late reply
-    meanwhile, mean the bus (or gimbal) is lost: streaming stops, a best-effort stop is sent,
-    ``error`` is set and the next ``set()`` raises ``BusError``.
+    ``gimbaltrack sim --delay-ms 150``), which show the gimbal hears us, and commands never
+    answered (``unanswered``). ``watchdog`` (default: a ``BusWatchdog`` with its default timeout)
+    judges the link from them; while it says ``disengaged`` no setpoint goes out (see the module's
+    docstring). Only a lost bus (``halt``) or a failure of the thread ends streaming: ``error`` is
+    set and the next ``set()`` raises ``BusError``.
     """
 
     def __init__(self, client: SpeedSender, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S, *,
-                 max_missed_replies: int = 10, clock: Callable[[], float] = time.monotonic) -> None:
+                 watchdog: BusWatchdog | None = None, clock: Callable[[], float] = time.monotonic) -> None:
         if not MIN_RATE_HZ <= rate_hz <= MAX_RATE_HZ:
             raise ValueError(f"the keep-alive rate must be {MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz (a command "
                              f"lasts 0.5 s; replies must be back by the next send), not {rate_hz:g}")
-        if not max_age > 0 or max_missed_replies < 1:
-            raise ValueError("max_age must be > 0 and max_missed_replies >= 1")
+        if not max_age > 0:
+            raise ValueError("max_age must be > 0")
         self.rate_hz = rate_hz
         self.max_age = max_age
-        self.max_missed_replies = max_missed_replies
+        self.watchdog = watchdog if watchdog is not None else BusWatchdog()
         self.stats: Counter[str] = Counter(dict.fromkeys(STAT_KEYS, 0))
         self.error: BaseException | None = None
         self._client = client
@@ -94,8 +104,9 @@ class SpeedStreamer:
         self._lock = threading.Lock()
         self._setpoint: _Setpoint | None = None
         self._latencies: list[float] = []
-        self._missed = 0
-        self._overdue: deque[PendingReply] = deque(maxlen=max_missed_replies)  # timed out, may yet be answered
+        self._overdue: deque[tuple[float, PendingReply]] = deque()  # (sent at, waiter): timed out, may yet be answered
+        self._engaged = True  # setpoints go out (False: disengaged, probing)
+        self._last_probe = -math.inf
         self._halt = threading.Event()
         self._wake = threading.Event()  # a new setpoint: send it now rather than at the next tick
         self._stopped = False
@@ -138,6 +149,7 @@ class SpeedStreamer:
         self._wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join()
+        self.watchdog.close()
         if first:
             self._client.stop_and_release()
 
@@ -149,6 +161,7 @@ class SpeedStreamer:
         self._wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join(timeout=2.0)
+        self.watchdog.close()
 
     def _run(self) -> None:
         period = 1.0 / self.rate_hz
@@ -182,6 +195,12 @@ class SpeedStreamer:
                 self._client.cancel(pending)
 
     def _tick(self) -> PendingReply | None:
+        if self.watchdog.poll() == DISENGAGED:
+            return self._disengaged()
+        if not self._engaged:
+            self._engaged = True
+            self.stats["reengaged"] += 1
+            log.warning("the gimbal answers again: taking speed control back")
         now = self._clock()
         with self._lock:
             setpoint = self._setpoint
@@ -191,11 +210,8 @@ class SpeedStreamer:
             message = SpeedControl(setpoint.yaw, setpoint.roll, setpoint.pitch, SPEED_HOLD)
         else:
             message = SpeedControl(0, 0, 0, SPEED_HOLD)
-        try:
-            pending = self._client.submit(message)
-        except SendError as exc:  # often passing (a full transmit queue): counted like a lost reply
-            self.stats["send_errors"] += 1
-            self._count_miss(f"not sent: {exc}")
+        pending = self._submit(message)
+        if pending is None:
             return None
         self.stats["sent"] += 1
         if not fresh:
@@ -206,40 +222,72 @@ class SpeedStreamer:
                 self._latencies.append(self._clock() - setpoint.stamp)
         return pending
 
-    def _count_late_replies(self) -> None:
-        """Commands that timed out but were answered since: the gimbal hears us, only slowly."""
-        answered = [waiter for waiter in self._overdue if waiter.done]
-        if not answered:
-            return
-        for waiter in answered:
-            self._overdue.remove(waiter)
-        self.stats["late_replies"] += sum(waiter.late for waiter in answered)
-        self._missed = 0
+    def _submit(self, message: SpeedControl) -> PendingReply | None:
+        """Send ``message``; a send the bus refuses (often passing: a full transmit queue, or no
+        node acknowledging a frame) is counted as a command never answered."""
+        try:
+            return self._client.submit(message)
+        except SendError as exc:
+            self.stats["send_errors"] += 1
+            self.stats["unanswered"] += 1
+            log.debug("speed command not sent: %s", exc)
+            self.watchdog.timed_out()
+            self.watchdog.unanswered()
+            return None
 
-    def _count_miss(self, what: str) -> None:
-        """One more speed command in a row without a reply; ``max_missed_replies`` = bus lost."""
-        self._missed += 1
-        log.warning("speed command %s (%d in a row)", what, self._missed)
-        if self._missed >= self.max_missed_replies:
-            raise BusError(f"no reply to {self._missed} consecutive speed commands (the last one {what})")
+    def _disengaged(self) -> PendingReply | None:
+        """Silence for the watchdog's timeout: stop and release the gimbal once, then probe it
+        with a release every ``PROBE_EVERY_S`` until it answers."""
+        if self._engaged:
+            self._engaged = False
+            self.stats["disengaged"] += 1
+            log.warning("the gimbal has not answered for %.1f s: stopping and releasing it until it answers",
+                        self.watchdog.timeout_s)
+            self._client.stop_and_release()
+        now = time.monotonic()
+        if now - self._last_probe < PROBE_EVERY_S:
+            return None
+        self._last_probe = now
+        pending = self._submit(SpeedControl(0, 0, 0, SPEED_RELEASE))
+        if pending is not None:
+            self.stats["probes"] += 1
+        return pending
+
+    def _count_late_replies(self) -> None:
+        """Commands that timed out but were answered since (the gimbal hears us, only slowly), and
+        those given up for good: no reply within the time one command lasts."""
+        now = time.monotonic()
+        kept: deque[tuple[float, PendingReply]] = deque()
+        for sent_at, waiter in self._overdue:
+            if waiter.done:
+                if waiter.late:
+                    self.stats["late_replies"] += 1
+                self.watchdog.replied(late=waiter.late)
+            elif now - sent_at >= SPEED_COMMAND_LASTS_S:
+                self.stats["unanswered"] += 1
+                self.watchdog.unanswered()
+            else:
+                kept.append((sent_at, waiter))
+        self._overdue = kept
 
     def _collect(self, pending: PendingReply | None) -> None:
-        """Account for the previous tick's reply; too many missing in a row = bus lost."""
+        """Account for the previous tick's reply, and for the replies still outstanding."""
         self._count_late_replies()
         if pending is None:
             return
         self._client.cancel(pending)
         if not pending.done:
             self.stats["reply_timeouts"] += 1
-            self._overdue.append(pending)
-            self._count_miss("timed out")
+            self._overdue.append((time.monotonic() - 1.0 / self.rate_hz, pending))
+            self.watchdog.timed_out()
             return
-        self._missed = 0
         try:
             self._client.result(pending)
             self.stats["replies"] += 1
+            self.watchdog.replied()
         except BusError:
             raise
         except GimbalError as exc:  # a NACK or an undecodable reply: counted, streaming goes on
             self.stats["reply_errors"] += 1
+            self.watchdog.replied(nack=True)
             log.warning("speed command reply: %s", exc)

@@ -44,6 +44,7 @@ from gimbal.messages.motion import (
     SPEED_TAKE_CONTROL,
     SpeedControl,
 )
+from gimbal.other_hosts import OtherHosts
 from gimbal.packet import REPLY_OPTIONAL
 from gimbal.pushes import PushCallback, PushHub
 from gimbal.transport import (
@@ -54,11 +55,14 @@ from gimbal.transport import (
     with_default_bitrate,
 )
 from gimbal.values import integer, number, shown
+from gimbal.watchdog import DEFAULT_TIMEOUT_S, BusWatchdog
 
 log = logging.getLogger(__name__)
 
 RX_POLL_S = 0.05  # the Notifier's receive timeout, and the pause after a receive error
 RX_GIVE_UP_S = 0.25  # receive errors for this long, without a frame between, mean the bus is lost
+STOP_RETRY_S = 0.5  # the final stop is resent until answered or this long has passed
+STOP_RESEND_S = 0.05  # between resends of an unanswered stop command
 NOTIFIER_STOP_S = 1.0  # how long close() waits for the Notifier's thread
 MAX_TIMEOUT = threading.TIMEOUT_MAX  # longer waits overflow the platform's time_t
 
@@ -103,12 +107,14 @@ class _BusWatch(can.Listener):
 class _Taps(can.Listener):
     """The listeners that want every frame as the bus saw it (a CAN log). On a bus that loops our
     own frames back marked as received (udp_multicast) those echoes are left out: the taps got
-    each of our frames at send already. Once the client closes (``close_at_packet_end``) they get
+    each of our frames at send already. Any other frame on our transmit id is another host's and
+    also goes to ``other_hosts``. Once the client closes (``close_at_packet_end``) they get
     frames until the gimbal's stream is between two packets, so a log never ends with half of one
     that the client did not read either."""
 
-    def __init__(self, transport: CanTransport) -> None:
+    def __init__(self, transport: CanTransport, other_hosts: OtherHosts) -> None:
         self.listeners: list[can.Listener] = []
+        self.other_hosts = other_hosts
         self._transport = transport
         self._gimbal_stream = PacketFramer()  # where the gimbal's packets start and end
         self._closing = False
@@ -118,7 +124,10 @@ class _Taps(can.Listener):
         self._closing = True
 
     def on_message_received(self, msg: can.Message) -> None:
-        if not self.listeners or self._closed or self._transport.take_echo(msg):
+        if self._closed or self._transport.take_echo(msg):
+            return
+        self.other_hosts.on_message_received(msg)
+        if not self.listeners:
             return
         if is_packet_frame(msg, self._transport.rx_id):
             if self._closing and not self._gimbal_stream.pending:
@@ -174,7 +183,8 @@ class GimbalSession:
         self._stops_only = False  # set by close(): other threads' commands must not follow its stop
         self._streamer: SpeedStreamer | None = None
         self._watch = _BusWatch(self._on_receive_error)
-        self._taps = _Taps(self.transport)
+        self.other_hosts = OtherHosts(tx_id)
+        self._taps = _Taps(self.transport, self.other_hosts)
         for listener in listeners:
             self._tap(listener)
         try:
@@ -247,19 +257,22 @@ class GimbalSession:
     def stop_and_release(self) -> None:
         """Zero speed (still in control), then zero with control released (bit 7 clear).
 
-        While the bus is receiving each waits for its reply (no retries: a failure is logged);
-        once the bus is known lost, or the client closed, they are only sent, best effort: a
-        stop asked for explicitly always goes out while the bus can carry it (on a bus this
-        client does not own, one still open), since an extra stop costs a controller one tick and
-        a missing one can leave the gimbal in SDK speed control. ``stats`` counts those that went
-        out (``stop_zero_sent``, ``stop_release_sent``), answered or not: one the gimbal left
-        unanswered or refused is on the bus (and in the CAN log) all the same.
+        While the bus is receiving, each is resent (same SEQ) every ``STOP_RESEND_S`` until the
+        gimbal answers: the zero for up to half of ``STOP_RETRY_S``, the release until
+        ``STOP_RETRY_S`` after the start (a failure is logged); once the bus is known lost, or the
+        client closed, they are only sent, best effort: a stop asked for explicitly always goes out
+        while the bus can carry it (on a bus this client does not own, one still open), since an
+        extra stop costs a controller one tick and a missing one can leave the gimbal in SDK
+        speed control. ``stats`` counts those that went out (``stop_zero_sent``,
+        ``stop_release_sent``), answered or not, and the resends (``stop_resends``): one the
+        gimbal left unanswered or refused is on the bus (and in the CAN log) all the same.
         """
-        for message in stop_messages():
+        deadline = time.monotonic() + STOP_RETRY_S
+        for message, until in zip(stop_messages(), (deadline - STOP_RETRY_S / 2, deadline)):
             name = "stop_zero_sent" if message.ctrl_byte & SPEED_TAKE_CONTROL else "stop_release_sent"
             try:
                 if self._rx_error is None and not self._closed and not self._on_receive_thread():
-                    self.request(message, retries=0)
+                    self._stop_until_answered(message, until)
                 else:
                     self.transport.send(self.replies.encode(message)[1])
             except (GimbalError, can.CanError, OSError) as exc:
@@ -269,6 +282,23 @@ class GimbalSession:
                     continue  # not sent
             self.stats[name] += 1
         self._speed_engaged = False
+
+    def _stop_until_answered(self, message: SpeedControl, until: float) -> None:
+        """Send ``message`` and resend the same packet until it is answered or ``until`` passes
+        (``GimbalTimeoutError``); a refusal raises ``ReturnCodeError``."""
+        started = time.monotonic()
+        waiter = self.submit(message)
+        try:
+            while not waiter.wait(max(0.0, min(STOP_RESEND_S, until - time.monotonic()))):
+                if time.monotonic() >= until:
+                    raise GimbalTimeoutError(f"{message.NAME}: no reply within {(until - started) * 1000:.0f} ms "
+                                             f"(sent every {STOP_RESEND_S * 1000:.0f} ms)")
+                self.stats["stop_resends"] += 1
+                self.replies.expect(waiter)
+                self._transmit(message, waiter.raw)
+        finally:
+            self.cancel(waiter)
+        self.result(waiter)
 
     @property
     def alive(self) -> bool:
@@ -442,10 +472,13 @@ class GimbalSession:
 
     # -- the speed keep-alive ----------------------------------------------------------------
 
-    def speed_streamer(self, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S) -> SpeedStreamer:
-        """Start the speed keep-alive (see ``gimbal.keepalive``); one per client at a time."""
+    def speed_streamer(self, rate_hz: float = 25.0, max_age: float = DEFAULT_MAX_AGE_S,
+                       bus_timeout: float = DEFAULT_TIMEOUT_S) -> SpeedStreamer:
+        """Start the speed keep-alive (see ``gimbal.keepalive``); one per client at a time. Its
+        ``watchdog`` releases the gimbal after ``bus_timeout`` s without a reply."""
         self._check_alive()
         if self._streamer is not None and self._streamer.running:
             raise GimbalError("a speed streamer is already running; stop() it first")
-        self._streamer = SpeedStreamer(self, rate_hz=rate_hz, max_age=max_age)
+        self._streamer = SpeedStreamer(self, rate_hz=rate_hz, max_age=max_age,
+                                       watchdog=BusWatchdog(bus_timeout))
         return self._streamer

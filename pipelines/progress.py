@@ -44,6 +44,12 @@ class ProgressReporter:
         self.stream.flush()
         self._drawn = True
 
+    def note(self, line: str) -> None:
+        """A line of its own on the stream (a warning), written over the progress line on a TTY so
+        that the next redraw comes below it; shown whether progress is enabled or not."""
+        self.stream.write(("\r" + line.ljust(150) if self._tty and self._drawn else line) + "\n")
+        self.stream.flush()
+
     def close(self) -> None:
         if self.enabled and self._drawn and self._tty:
             self.stream.write("\n")

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from gimbal.errors import GimbalError
 from gimbal.signals import deferred_signals
+from gimbal.watchdog import DEFAULT_TIMEOUT_S
 from pipelines.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartConfirmer
 from pipelines.control import CameraModel, ControlConfig, make_controller
 from pipelines.control.gimbal_link import GimbalLink, Signs
@@ -22,6 +23,7 @@ from pipelines.control.tuning import settings_of
 from pipelines.loop import (
     Loop, PlotSink, ProgressSink, Recorder, SummarySink, TelemetrySink, VideoSink, loop_panels,
 )
+from pipelines.loop.link import LinkNotices, LinkSink, link_health
 from pipelines.loop.record import FrameRecord
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
@@ -67,6 +69,7 @@ class TrackOptions:
     video: bool = True
     video_width: int | None = DEFAULT_VIDEO_WIDTH  # None: the source's own size
     progress: bool = True
+    bus_timeout: float = DEFAULT_TIMEOUT_S  # silence before the gimbal is released (taken back when it answers)
 
     @property
     def signs(self) -> Signs:
@@ -126,7 +129,7 @@ class TrackSession:
         self.subject = AcquiringSubject(tracker, detector, source.size, roi=options.roi, pick=options.pick,
                                         confirmer=confirmer)
         self.camera = CameraModel(width, height, hfov_deg=options.hfov_deg)
-        self.link = GimbalLink(client, rate_hz=options.rate_hz, signs=options.signs)
+        self.link = GimbalLink(client, rate_hz=options.rate_hz, signs=options.signs, bus_timeout=options.bus_timeout)
         self.recorder = Recorder(client, requested=options.record)
         self.feedback = (source.is_live if options.attitude_feedback == "auto"
                          else options.attitude_feedback == "on")
@@ -156,7 +159,11 @@ class TrackSession:
         if can_log is not None:
             self.loop.attach(_CanLogCheck(can_log))
         self.progress = ProgressSink(source.frame_count, enabled=options.progress)
+        self.loop.attach(LinkSink(LinkNotices(options.bus_timeout, self._warn), self.recorder))
         self.loop.attach(self.progress)
+
+    def _warn(self, line: str) -> None:
+        self.progress.reporter.note(f"gimbaltrack track: warning: {line}")
 
     @property
     def frames(self) -> int:
@@ -253,6 +260,7 @@ class TrackSession:
             "latency_ms": {k: (v * 1000.0 if isinstance(v, float) else v)
                            for k, v in latency_percentiles(self.link.latencies()).items()},
             "speed_commands": dict(self.link.stats()),
+            "bus_health": link_health(self.link.health(), self.link.other_hosts()),
             "recording": self.recorder.status,
             "settings": settings_of(self.loop.controller.config),
             "outputs": {k: str(v) for k, v in self.paths.items()},

@@ -122,11 +122,11 @@ def open_can_bus(options: dict[str, Any]) -> can.BusABC:
 @contextmanager
 def simulated_gimbal(args: argparse.Namespace) -> Iterator[tuple[can.BusABC, SimulatedGimbal]]:
     """(host bus, simulated gimbal) for ``-i sim``: the simulator listens on --tx-id and answers
-    on --rx-id; both are stopped on exit. A channel or bitrate given with it is refused: whoever
+    on --rx-id, with the faults of ``--sim-faults`` where a command offers it; both are stopped on exit. A channel or bitrate given with it is refused: whoever
     gives one means a real bus and forgot -i."""
     refuse_bus_options(args)
     check_sim_ids(args)
-    host_bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id))
+    host_bus, sim = start_in_process(SimConfig(rx_id=args.tx_id, tx_id=args.rx_id), getattr(args, "sim_faults", None))
     try:
         yield host_bus, sim
     finally:

@@ -5,6 +5,7 @@ import argparse
 import json
 import socket
 import sys
+import time
 from collections.abc import Iterator
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
@@ -13,12 +14,15 @@ from typing import Any
 from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
+from gimbal.watchdog import DEFAULT_TIMEOUT_S, DEGRADED_SILENCE_S
 from gimbal.signals import SignalExit, deferred_signals
 from gimbal.values import shown
 from pipelines.acquire import PICKS, check_roi_in_frame, parse_roi
 from pipelines.cli.batch_options import add_batch_options, batch_jobs
-from pipelines.cli.bus import choose_track_bus, open_host_bus
+from pipelines.cli.bus import SIM_INTERFACE, choose_track_bus, open_host_bus
 from pipelines.cli.firmware_opts import add_legacy_order_option
+from pipelines.cli.sim_faults import parse_sim_faults
+from pipelines.loop.link import link_degraded, link_report
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.cli.track_batch import run_track_batch
 from pipelines.control import ControlConfig, controller_names
@@ -31,6 +35,9 @@ from tracker.detectors import Detector
 from tracker.registry import DEFAULT_MODEL_TRACKER
 
 DEFAULT_DETECTOR = "motion"
+LISTEN_S = 0.5  # before taking control: another controller streams at 4 Hz at the least (two commands a 0.5 s)
+EXIT_DEGRADED_LINK = 3
+EXIT_OTHER_CONTROLLER = 4
 FPS_RANGE = (0.1, 1000.0)  # a frame every 10 s to 1000 a second; the video writer takes these
 
 
@@ -51,8 +58,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "outputs in --out: annotated.avi, telemetry.jsonl, can.log, summary.json, plot.png; with several\n"
         "  SOURCEs, each in --out/<its name>/, each run against its own simulated gimbal (not on a real bus),\n"
         "  their reports in the order given; the exit status is the worst of theirs\n"
-        "exit status: 0 done; 1 the gimbal, bus, source or an output failed mid-run; 2 bad input;\n"
-        "  130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to stop in every case)",
+        "exit status: 0 done; 3 done, but the gimbal link was degraded (replies missing, the gimbal\n"
+        "  released for silence) or another controller was seen; 4 another controller drives the gimbal\n"
+        "  (nothing taken over; --shared-bus to run anyway); 1 the bus, source or an output failed\n"
+        "  mid-run; 2 bad input; 130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to\n"
+        "  stop in every case)",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("source", nargs="+", metavar="SOURCE", help="video file, image folder, camera index "
                         "(e.g. 0) or stream URL (udp://, rtsp://, http://); several: see below")
@@ -116,6 +126,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      "chosen without -i (the summary names it)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_bus_options(parser, fallback="the built-in simulated gimbal")
+    link = parser.add_argument_group("gimbal link")
+    link.add_argument("--bus-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S",
+                      help=f"release the gimbal after this long without a reply, and take it back when it "
+                      f"answers (default: {DEFAULT_TIMEOUT_S:g}; above {DEGRADED_SILENCE_S:g}); tracking and "
+                      "the outputs go on meanwhile")
+    link.add_argument("--shared-bus", action="store_true",
+                      help="run even if another host is driving this gimbal (by default track listens "
+                      f"{LISTEN_S:g} s first and refuses, exit 4)")
+    link.add_argument("--sim-faults", type=parse_sim_faults, metavar="KEY=VALUE,...",
+                      help="faults of the built-in simulated gimbal (-i sim), as gimbaltrack sim's options: "
+                      "drop, corrupt, fault-direction, delay-ms, nack, silent (START:END s), seed; "
+                      "e.g. drop=0.2 or silent=6:6.3")
     add_legacy_order_option(parser)
     add_batch_options(parser, "inputs")
     parser.set_defaults(func=run_track)
@@ -139,6 +161,9 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         raise CliError(f"--hfov takes 0 < DEG < 180, not {args.hfov:g}")
     if args.max_frames is not None and args.max_frames < 1:
         raise CliError("--max-frames must be at least 1")
+    if not DEGRADED_SILENCE_S < args.bus_timeout < float("inf"):
+        raise CliError(f"--bus-timeout takes a finite time above {DEGRADED_SILENCE_S:g} s (a shorter silence "
+                       f"only degrades the link), not {args.bus_timeout:g}")
     detect = args.detect or (None if roi else DEFAULT_DETECTOR)
     return TrackOptions(
         out_dir=args.out, roi=roi, detect=detect,
@@ -150,6 +175,7 @@ def _options(args: argparse.Namespace) -> TrackOptions:
         yaw_attitude_sign=-1 if args.invert_yaw_attitude else 1,
         pitch_attitude_sign=-1 if args.invert_pitch_attitude else 1,
         max_frames=args.max_frames, video=not args.no_video, video_width=args.video_width or None,
+        bus_timeout=args.bus_timeout,
         progress=not args.quiet)
 
 
@@ -183,6 +209,8 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
         except (ValueError, OSError) as exc:
             raise CliError(str(exc)) from None
         where, chosen = choose_track_bus(args)
+        if args.sim_faults is not None and args.interface != SIM_INTERFACE:
+            raise CliError("--sim-faults is for the built-in simulated gimbal (-i sim)")
         with _console_socket(args) as console, open_host_bus(args) as bus, ExitStack() as held:
             # from the output folder's creation until a session exists that can finish its outputs,
             # a Ctrl-C or SIGTERM is held; _session delivers it where the session writes its summary
@@ -192,6 +220,8 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
             try:
                 with GimbalClient(bus, tx_id=args.tx_id, rx_id=args.rx_id, listeners=[can_log],
                                   legacy_attitude_order=args.legacy_order) as client:
+                    if not (args.shared_bus or args.interface == SIM_INTERFACE):
+                        _refuse_a_second_controller(client, where)
                     try:
                         session = _session(options, source, client, where, subject, can_log, held)
                     except CliError:  # it says why the run ended; a signal held meanwhile adds nothing
@@ -206,6 +236,16 @@ def _open_and_run(options: TrackOptions, args: argparse.Namespace) -> int:
                         return _run(session, args)
             finally:
                 can_log.stop()
+
+
+def _refuse_a_second_controller(client: GimbalClient, where: str) -> None:
+    """Listen ``LISTEN_S`` before taking control: another host's speed or control commands on our
+    transmit id mean someone drives this gimbal already, and two controllers fight over it."""
+    if client.other_hosts.wait_for_control(LISTEN_S):
+        time.sleep(min(LISTEN_S, 0.1))  # a few more of its commands, to name what it sends
+        raise CliError(f"another host is driving the gimbal on {where}: it sent "
+                       f"{client.other_hosts.seen().describe()} on 0x{client.transport.tx_id:03X}; "
+                       "stop it first, or pass --shared-bus to run anyway", exit_code=EXIT_OTHER_CONTROLLER)
 
 
 @contextmanager
@@ -296,7 +336,7 @@ def _run(session: TrackSession, args: argparse.Namespace) -> int:
     if summary["status"] == "output failed":  # an output that could not be finalised (a full disk)
         raise _stopped_with(summary["error"], session)
     _report(summary, args)
-    return 0
+    return EXIT_DEGRADED_LINK if link_degraded(summary["bus_health"]) else 0
 
 
 def _stopped_with(error: object, session: TrackSession) -> CliError:
@@ -330,6 +370,7 @@ def _report(summary: dict[str, Any], args: argparse.Namespace) -> None:
                      f"p95 {latency['p95']:.1f} ms, p99 {latency['p99']:.1f} ms")
     if summary["recording"]["requested"]:
         lines.append(f"recording: {_recording_text(summary['recording'])}")
+    lines.append(link_report(summary["bus_health"], summary["speed_commands"].get("sent", 0)))
     lines.append(f"outputs: {Path(summary['outputs']['summary']).parent}")
     print("\n".join(lines), file=sys.stdout)
 

@@ -15,10 +15,13 @@ from typing import TYPE_CHECKING
 from gimbal.keepalive import DEFAULT_MAX_AGE_S
 from gimbal.messages.limits import MAX_SPEED_DPS
 from gimbal.messages.telemetry import ParameterPush
+from gimbal.watchdog import DEFAULT_TIMEOUT_S
 from pipelines.control.attitude import Attitude, AttitudeHistory
 
 if TYPE_CHECKING:
     from gimbal.client import GimbalClient
+    from gimbal.other_hosts import OtherHostsSeen
+    from gimbal.watchdog import BusHealth
     from gimbal.keepalive import SpeedStreamer
     from pipelines.control.controller import RateCommand
 
@@ -54,9 +57,10 @@ class GimbalLink:
     """
 
     def __init__(self, client: GimbalClient, *, rate_hz: float = 25.0, signs: Signs = Signs(),
-                 history: AttitudeHistory | None = None) -> None:
+                 history: AttitudeHistory | None = None, bus_timeout: float = DEFAULT_TIMEOUT_S) -> None:
         self.client = client
         self.rate_hz = rate_hz
+        self.bus_timeout = bus_timeout
         self.signs = signs
         self.history = history if history is not None else AttitudeHistory()
         self._streamer: SpeedStreamer | None = None
@@ -69,7 +73,7 @@ class GimbalLink:
         self.client.set_push(True)
         if wait_s is not None:
             self.client.wait_for_push(ParameterPush, wait_s)
-        self._streamer = self.client.speed_streamer(rate_hz=self.rate_hz)
+        self._streamer = self.client.speed_streamer(rate_hz=self.rate_hz, bus_timeout=self.bus_timeout)
 
     def on_push(self, msg: ParameterPush, t: float) -> None:
         """Record a push's attitude (degrees, as the push gives it); one without valid angles is skipped."""
@@ -111,7 +115,7 @@ class GimbalLink:
 
     def resume(self) -> None:
         """A new keep-alive after ``pause`` (the old one's counts and latencies are kept)."""
-        self._streamer = self.client.speed_streamer(rate_hz=self.rate_hz)
+        self._streamer = self.client.speed_streamer(rate_hz=self.rate_hz, bus_timeout=self.bus_timeout)
 
     def recenter(self) -> None:
         """The protocol's recenter (send it paused: a speed command would take over again)."""
@@ -125,6 +129,14 @@ class GimbalLink:
     @property
     def started(self) -> bool:
         return self._streamer is not None
+
+    def health(self) -> BusHealth | None:
+        """The link's state as the keep-alive's watchdog sees it; None before ``start``."""
+        return self._streamer.watchdog.snapshot() if self._streamer is not None else None
+
+    def other_hosts(self) -> OtherHostsSeen:
+        """What other hosts sent on the bus to this gimbal so far."""
+        return self.client.other_hosts.seen()
 
     def latencies(self) -> list[float]:
         """Seconds from each setpoint's frame to its first send on the bus."""

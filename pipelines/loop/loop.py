@@ -156,7 +156,8 @@ class Loop:
             t_video=None if self.video_fps is None else frame.index / self.video_fps,
             estimate=estimate, command=command, attitude=self.gimbal.latest(), dropped=self.dropped(),
             recording=self.recorder is not None and self.recorder.active,
-            candidates=self.subject.candidates, paused=self.paused, operator=notes)
+            candidates=self.subject.candidates, paused=self.paused, operator=notes,
+            bus=self.gimbal.health(), other_hosts=self.gimbal.other_hosts())
         for sink in self.sinks:
             sink.on_frame(record, frame)
         return record

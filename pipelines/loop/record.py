@@ -7,6 +7,8 @@ from typing import Any
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from gimbal.other_hosts import OtherHostsSeen
+    from gimbal.watchdog import BusHealth
     from pipelines.control.attitude import Attitude
     from pipelines.control.controller import RateCommand
     from tracker.detectors import Detection
@@ -37,6 +39,8 @@ class FrameRecord:
     candidates: tuple[Detection, ...] = ()  # the detector's candidates of this frame, if it ran
     paused: bool = False  # an operator paused the gimbal: no command was sent for this frame
     operator: tuple[dict[str, Any], ...] = ()  # what an operator did at the start of this step
+    bus: BusHealth | None = None  # the gimbal link's state after this frame's command (None: not streaming)
+    other_hosts: OtherHostsSeen | None = None  # what other hosts sent to the gimbal so far
 
     @property
     def state(self) -> str:

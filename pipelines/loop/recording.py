@@ -45,6 +45,20 @@ class Recorder:
         if self.active:
             self._camera_action(self.client.stop_recording, "stopped", "stop_confirmed", recording=False)
 
+    def restore(self) -> None:
+        """The gimbal was taken back after a silence: a recording that should be running is started
+        again if the camera stopped meanwhile (a gimbal power-cycled); ``status["restarts"]`` counts it."""
+        if not self.active:
+            return
+        try:
+            if self.client.camera_status():
+                return
+        except GimbalError as exc:
+            self.status["status_query_error"] = str(exc)
+            return
+        self.status["restarts"] = self.status.get("restarts", 0) + 1
+        self._camera_action(self.client.start_recording, "started", "start_confirmed", recording=True)
+
     def finish(self) -> None:
         """At the end of a run: say why a requested recording never started, stop a running one."""
         if self.requested and not self._acquired:

@@ -45,6 +45,10 @@ def telemetry_record(record: FrameRecord) -> dict[str, Any]:
     line["state"] = record.state  # paused, whatever the tracker says
     if record.operator:
         line["operator"] = list(record.operator)
+    if record.bus is not None:
+        line["bus"] = record.bus.as_dict()
+    if record.other_hosts is not None:
+        line["other_hosts"] = record.other_hosts.control
     return line
 
 

@@ -25,7 +25,7 @@ class Client:
     def wait_for_push(self, cls, timeout):
         self.calls.append(("wait_for_push", cls, timeout))
 
-    def speed_streamer(self, rate_hz):
+    def speed_streamer(self, rate_hz, bus_timeout):
         self.calls.append(("speed_streamer", rate_hz))
         return Streamer(self.calls)
 

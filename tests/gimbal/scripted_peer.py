@@ -180,3 +180,11 @@ def speed_messages(peer: ScriptedPeer) -> list[tuple[int, int, int, int]]:
 assert (SPEED_HOLD, SPEED_RELEASE) == (0x88, 0x08), "speed ctrl bytes are not the R SDK's 0x88/0x08"
 ZERO = (0, 0, 0, SPEED_HOLD)  # zero speed, still in control
 RELEASE = (0, 0, 0, SPEED_RELEASE)  # zero speed, control released (bit 7 clear)
+
+
+def ends_with_stop(sent: list[tuple[int, int, int, int]]) -> bool:
+    """Whether the speed commands end with the safety stop: zero in control, then the release,
+    each sent once or, unanswered, resent until its time was up (issue #26 item 4)."""
+    releases = len(sent) - next((i for i in range(len(sent) - 1, -1, -1) if sent[i] != RELEASE), -1) - 1
+    rest = sent[:len(sent) - releases]
+    return releases >= 1 and bool(rest) and rest[-1] == ZERO

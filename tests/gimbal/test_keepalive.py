@@ -10,6 +10,7 @@ from gimbal.client import GimbalClient
 from gimbal.errors import BusError, GimbalError, RangeError
 from gimbal.keepalive import STAT_KEYS, SpeedStreamer
 from gimbal.messages.motion import SpeedControl
+from gimbal.watchdog import DISENGAGED
 from tests.gimbal.scripted_peer import (
     RELEASE,
     ZERO,
@@ -125,15 +126,26 @@ def test_reply_errors_are_counted_and_streaming_goes_on(client: GimbalClient, pe
     streamer.set(1, 0)
 
 
-def test_consecutive_reply_timeouts_mean_the_gimbal_is_lost(client: GimbalClient, peer: ScriptedPeer) -> None:
+def test_a_silent_gimbal_is_released_after_the_bus_timeout_and_taken_back_when_it_answers(
+        client: GimbalClient, peer: ScriptedPeer) -> None:
+    """Issue #26 item 1: ten unanswered commands once ended streaming for good (a BusError at the
+    next set(), the run over). Now streaming goes on, the gimbal is stopped and released after the
+    watchdog's timeout, probed with releases, and taken back when it answers."""
     peer.silence(SpeedControl)
-    streamer = SpeedStreamer(client, max_missed_replies=3)
-    poll(lambda: streamer.error is not None)
-    assert not streamer.running
-    assert streamer.stats["reply_timeouts"] == 3
-    with pytest.raises(BusError, match="3 consecutive"):
-        streamer.set(1, 0)
-    poll(lambda: speed_messages(peer)[-2:] == [ZERO, RELEASE])  # the best-effort stop went out
+    streamer = client.speed_streamer(max_age=60.0, bus_timeout=0.6)
+    streamer.set(1, 0)
+    poll(lambda: streamer.watchdog.poll() == DISENGAGED)
+    poll(lambda: streamer.stats["probes"] >= 2)
+    assert streamer.running and streamer.error is None
+    streamer.set(2, 0)  # the run goes on: setpoints are taken, not sent
+    sent = speed_messages(peer)
+    first_release = sent.index(RELEASE)
+    assert sent[first_release - 1] == ZERO and set(sent[first_release:]) == {RELEASE}
+    assert streamer.stats["unanswered"] >= 10 and streamer.stats["disengaged"] == 1
+    peer.answer(SpeedControl)
+    peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 20 and m.ctrl_byte == ZERO[3])
+    assert streamer.stats["reengaged"] == 1
+    assert streamer.watchdog.snapshot().disengagements == 1
 
 
 def test_a_send_refused_now_and_then_is_counted_and_streaming_goes_on(channel: str, peer: ScriptedPeer) -> None:
@@ -155,17 +167,22 @@ def test_a_send_refused_now_and_then_is_counted_and_streaming_goes_on(channel: s
     bus.shutdown()
 
 
-def test_a_bus_that_keeps_refusing_stops_streaming(channel: str, peer: ScriptedPeer) -> None:
+def test_a_bus_that_keeps_refusing_disengages_and_resumes_when_it_sends_again(channel: str,
+                                                                              peer: ScriptedPeer) -> None:
+    """Sends refused for longer than the bus timeout (no node acknowledging: a gimbal unplugged)
+    disengage instead of ending the run; the adapter sending again re-engages."""
     bus = FlakyBus(channel=channel)
     with GimbalClient(bus) as gimbal:
-        streamer = gimbal.speed_streamer()
+        streamer = gimbal.speed_streamer(max_age=60.0, bus_timeout=0.6)
         streamer.set(3, 3)
         peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 30)
         bus.fail_send = True
-        poll(lambda: streamer.error is not None)
-        with pytest.raises(BusError, match="adapter gone"):
-            streamer.set(1, 0)
-        bus.fail_send = False  # the adapter comes back: leaving still stops the gimbal
+        poll(lambda: streamer.stats["disengaged"] == 1)
+        streamer.set(1, 0)  # no error: the run goes on
+        bus.fail_send = False
+        poll(lambda: streamer.stats["reengaged"] == 1)
+        peer.wait_for(SpeedControl, where=lambda m: m.yaw_speed == 10 and m.ctrl_byte == ZERO[3])
+        assert streamer.error is None and streamer.stats["send_errors"] >= 10
     assert speed_messages(peer)[-2:] == [ZERO, RELEASE]
     bus.shutdown()
 

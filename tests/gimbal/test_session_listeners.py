@@ -11,6 +11,7 @@ from gimbal.errors import BusError
 from gimbal.messages import message_packet
 from gimbal.messages.motion import AnglesReply, GetAngles
 from gimbal.messages.telemetry import ParameterPush
+from gimbal.other_hosts import OtherHosts
 from gimbal.packet import encode_packet
 from gimbal.session import _Taps
 from gimbal.transport import HOST_RX_ID, HOST_TX_ID, CanTransport, packet_frames
@@ -55,7 +56,7 @@ def test_a_bus_with_a_notifier_of_its_own_is_refused_in_one_line(channel: str) -
 def test_closing_lets_the_taps_finish_the_packet_in_progress_and_no_more(channel: str) -> None:
     bus = can.Bus(interface="virtual", channel=channel)
     reader = can.BufferedReader()
-    taps = _Taps(CanTransport(bus))
+    taps = _Taps(CanTransport(bus), OtherHosts())
     taps.listeners.append(reader)
     push = packet_frames(encode_packet(message_packet(ParameterPush(0x01, 1, 2, 3), 7)), HOST_RX_ID)
     assert len(push) > 2

@@ -57,6 +57,12 @@ class Link:
     def send(self, command, stamp=None):
         self.sent.append((command.yaw_dps, command.pitch_dps, stamp))
 
+    def health(self):
+        return None
+
+    def other_hosts(self):
+        return None
+
 
 class Sink:
     def __init__(self, name: str, seen: list) -> None:

@@ -87,7 +87,7 @@ def test_the_summary_is_written_while_running_and_synced_at_the_end(
 # The telemetry of a file run, line by line: the documented keys (docs/outputs.md), where each frame
 # sits in the recording (``t_video``), nothing dropped, and rates in the project's sign convention.
 KEYS = {"frame", "t", "t_video", "t_run", "box", "velocity", "confidence", "state", "error_deg", "rate_dps",
-        "mode", "attitude_deg", "attitude_t", "dropped"}
+        "mode", "attitude_deg", "attitude_t", "dropped", "bus", "other_hosts"}
 
 
 def test_a_file_runs_telemetry_has_every_column_and_the_recordings_time(tmp_path: Path) -> None:
