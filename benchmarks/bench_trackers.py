@@ -24,7 +24,7 @@ from tracker.data_paths import shared_data_dir, shared_sequences
 from tracker.datasets import Sequence, load_sequence
 from tracker.estimate import TargetEstimate, TrackState
 from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
-from tracker.registry import DEFAULT_MODEL_TRACKER, make_tracker
+from tracker.registry import EMBEDDED_TRACKER, make_tracker
 
 BASELINE = "opencv-csrt"
 ONNX_MODELS = ("nanotrack3", "vittrack", "fear")  # each runs plain and inside the subject tracker
@@ -55,7 +55,7 @@ def contenders(model_dir: Path | None) -> dict[str, object]:
     table["gimbaltrack csrt-fast"] = lambda: make_tracker("csrt-fast")
     table["dcf backend alone"] = lambda: BareBackend(make_backend("dcf"))
     table["gimbaltrack default (no models: dcf)"] = lambda: make_tracker("default")
-    table[f"gimbaltrack default (embedded: {DEFAULT_MODEL_TRACKER})"] = lambda: make_tracker("default")
+    table[f"gimbaltrack {EMBEDDED_TRACKER} (embedded model files)"] = lambda: make_tracker(EMBEDDED_TRACKER)
     if model_dir is not None:
         table["opencv-nano"] = lambda: BareBackend(make_backend("nano", model_dir))
         table["nanotrack backend alone"] = lambda: BareBackend(make_backend("nanotrack", model_dir))

@@ -136,8 +136,6 @@ def main(argv: list[str] | None = None, release: Iterable[int] | None = None) ->
     standard_streams()
     quiet_opencv(given)
     warnings.formatwarning = _one_line_warning
-    # Said once a run, however many trackers it makes (eval makes one to check the name, then one a sequence).
-    warnings.filterwarnings("once", message="the default tracker's model")
     try:
         status = _run(argv, release, run)
     except SystemExit:  # argparse's --help (0) or usage error (2): its text is flushed here, not at exit

@@ -19,7 +19,7 @@ from pipelines.control.metrics import MAX_ERROR, OVERSHOOT_WINDOW_S
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.summary import write_summary
 from pipelines.progress import ProgressReporter
-from tracker.registry import DEFAULT_BACKEND, DEFAULT_MODEL_TRACKER, available_trackers
+from tracker.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers
 
 if TYPE_CHECKING:
     from pipelines.loop import FrameRecord
@@ -55,7 +55,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "or p (speed proportional to pixel error, the public-driver baseline)")
     parser.add_argument("--tracker", default="default", choices=[ORACLE, *available_trackers()], metavar="NAME",
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
-                        f"{DEFAULT_MODEL_TRACKER} on the model files shipped with gimbaltrack, else {DEFAULT_BACKEND}), "
+                        f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND}), "
                         f"or {ORACLE}: the ground-truth box is the detection, isolating the control loop")
     parser.add_argument("--model-dir", type=existing_dir, metavar="DIR",
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "

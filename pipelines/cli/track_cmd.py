@@ -32,7 +32,6 @@ from pipelines.sources import FrameSource, SourceError, open_source
 from pipelines.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
 from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
-from tracker.registry import DEFAULT_MODEL_TRACKER
 
 DEFAULT_DETECTOR = "motion"
 LISTEN_S = 0.5  # before taking control: another controller streams at 4 Hz at the least (two commands a 0.5 s)
@@ -76,7 +75,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
-                         f"is {DEFAULT_MODEL_TRACKER} on the model files shipped with gimbaltrack, else dcf)")
+                         "is nanotrack when --model-dir holds its files, else dcf; nanotrack3 runs on the model files "
+                         "shipped with gimbaltrack)")
     subject.add_argument("--model-dir", type=existing_dir,
                          help="folder with optional model files: NanoTrack v3 (instead of the shipped ones), "
                          "NanoTrack v2, VitTrack, FEAR-XS and YuNet (then the face detector)")

@@ -36,9 +36,7 @@ def test_the_detector_runs_only_without_a_subject_and_finds_it_again(
     monkeypatch.setattr(pipelines.track_session, "make_detector", lambda *a: counted("detect", make_detector(*a)))
     monkeypatch.setattr(pipelines.track_session, "make_tracker", lambda *a: counted("init", make_tracker(*a)))
     clip = make_clip(tmp_path / "back.avi", 90, _position)
-    # dcf: NanoTrack v3, the default, follows the returning subject on the sliver that came into view
-    # first (a known gap of the default, docs/tracker.md); what is tested here is track's detector rule.
-    assert run_track(clip, tmp_path / "out", "--detect", "motion", "--no-video", "--tracker", "dcf") == 0
+    assert run_track(clip, tmp_path / "out", "--detect", "motion", "--no-video") == 0
     records = read_telemetry(tmp_path / "out" / "telemetry.jsonl")
     states = [r["state"] for r in records]
     lost = states.index("lost")
@@ -48,6 +46,8 @@ def test_the_detector_runs_only_without_a_subject_and_finds_it_again(
         "not found again"
     assert calls["init"] == 1, "started afresh, forgetting the subject's look"
     assert all(r["box"][2] > 0.9 * BOX for r in records[back:])
-    # every frame without a subject, the frame whose detection started the tracker and the one
-    # whose detection (or template search) found it again
-    assert calls["detect"] == states.count("acquiring") + states.count("lost") + 2
+    # every frame without a subject and the frame whose detection started the tracker; and the frame
+    # it was found again in when the detector (or the template search) found it there, not when the
+    # tracker's own filter picked it up first (dcf does since it learns from its first 20 frames)
+    without_subject = states.count("acquiring") + states.count("lost")
+    assert without_subject + 1 <= calls["detect"] <= without_subject + 2

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from tracker.detectors import make_detector
-from tracker.registry import DEFAULT_MODEL_TRACKER, make_tracker
+from tracker.registry import DEFAULT_BACKEND, make_tracker
 
 
 @pytest.fixture(params=["missing", "file"])
@@ -31,5 +31,5 @@ def test_make_detector_refuses_it(kind: str, not_a_folder: Path) -> None:
 
 def test_a_folder_without_models_still_gives_the_defaults(tmp_path: Path) -> None:
     # issue #23: the default's model ships with the package, so an empty folder leaves it on those files
-    assert make_tracker("default", model_dir=tmp_path).name == DEFAULT_MODEL_TRACKER
+    assert make_tracker("default", model_dir=tmp_path).name == DEFAULT_BACKEND
     assert type(make_detector("face", model_dir=tmp_path)).__name__ == "HaarFaceDetector"

@@ -1,0 +1,54 @@
+"""NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir. The
+default stays the correlation filter (docs/tracker.md says why)."""
+import json
+import shutil
+import subprocess
+
+import pytest
+
+from tests import fake_onnx
+from tests.support import cli_command
+from tests.tracker.test_eval_cli import write_otb
+from tracker import registry
+from tracker.registry import EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
+
+
+def test_nanotrack3_runs_on_the_embedded_model_files_with_their_licence():
+    subject = make_tracker(EMBEDDED_TRACKER)
+    assert subject.name == "nanotrack3" and subject.model == str(EMBEDDED_MODELS)
+    folder = EMBEDDED_MODELS / "nanotrack_v3"
+    assert sorted(p.name for p in folder.glob("*.onnx")) == ["nanotrack_backbone.onnx", "nanotrack_head.onnx"]
+    assert any(folder.glob("LICENSE*")) and (folder / "PROVENANCE.md").is_file()
+
+
+def test_the_package_data_ships_the_model_folder():
+    text = (EMBEDDED_MODELS.parent.parent / "pyproject.toml").read_text()
+    assert '"tracker" = ["models/*/*"]' in text
+
+
+def test_the_default_is_the_correlation_filter_without_a_model_folder():
+    subject = make_tracker()
+    assert subject.name == "dcf" and subject.model is None
+
+
+def test_a_damaged_embedded_file_is_named(tmp_path, monkeypatch):
+    shutil.copytree(EMBEDDED_MODELS, tmp_path / "models")
+    (tmp_path / "models" / "nanotrack_v3" / "nanotrack_head.onnx").write_bytes(b"junk!")
+    monkeypatch.setattr(registry, "EMBEDDED_MODELS", tmp_path / "models")
+    with pytest.raises(ValueError, match="nanotrack_head"):
+        make_tracker(EMBEDDED_TRACKER)
+
+
+def test_a_model_dir_holding_nanotrack3s_files_is_used(tmp_path):
+    models = fake_onnx.onnx_model_files(tmp_path)
+    subject = make_tracker(EMBEDDED_TRACKER, models)
+    assert subject.name == "nanotrack3" and subject.model == str(models)
+
+
+def test_eval_json_names_the_tracker_and_its_model(tmp_path):
+    otb = write_otb(tmp_path / "otb", frames=5)
+    captured = subprocess.run(cli_command("eval", str(otb), "--tracker", EMBEDDED_TRACKER, "--json"),
+                              capture_output=True, text=True, timeout=120)
+    assert captured.returncode == 0, captured.stderr
+    summary = json.loads(captured.stdout.splitlines()[-1])
+    assert summary["tracker"] == "nanotrack3" and summary["model"] == str(EMBEDDED_MODELS)
