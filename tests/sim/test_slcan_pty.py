@@ -98,7 +98,7 @@ def test_gimbal_and_track_over_slcan_against_the_sim_process(tmp_path: Path) -> 
         assert json.loads(angles.stdout)["joint"] == {"yaw": 0.0, "roll": 0.0, "pitch": 0.0}
         out = tmp_path / "track"
         track = subprocess.run(cli_command("track", "samples/demo.mp4", "--roi", "138,152,64,96", "--max-frames",
-                                           "30", "--no-video", "--quiet", "--out", str(out), *bus),
+                                           "90", "--no-video", "--quiet", "--out", str(out), *bus),
                                capture_output=True, text=True, timeout=120, cwd=ROOT, env=env)
         assert track.returncode == 0, track.stderr
         assert "Traceback" not in track.stderr
