@@ -15,7 +15,8 @@ A reply that echoes the SEQ of a request given up on (timed out, cancelled) is l
 that request answered late (``PendingReply.late``) and is never handed to a newer request for the
 same command. SEQs of requests given up on are
 not handed out again while they are remembered, so such a reply cannot be mistaken either.
-Replies that match no outstanding request (``stale_replies``), or are too short to name the
+A resent request is answered once per copy; the replies after the first are
+``duplicate_replies``, expected and dropped. Replies that match no outstanding request (``stale_replies``), or are too short to name the
 command they answer (``bad_replies``), are counted and dropped.
 """
 from __future__ import annotations
@@ -43,6 +44,7 @@ FIRST_SEQ = 0x1122  # DJI's demo starts here
 ECHO_EVIDENCE = 3  # replies in a row paired only by command that show the gimbal does not echo SEQs
 PAIRED_BY_COMMAND_KEPT = 16  # SEQs of the latest requests paired by command, for a late echo
 GIVEN_UP_KEPT = 64  # SEQs of the latest requests given up on, for their late replies
+RESENT_KEPT = 64  # SEQs of the latest answered requests that went out more than once
 
 
 class PendingReply:
@@ -56,6 +58,7 @@ class PendingReply:
         self.packet: Packet | None = None
         self.error: BaseException | None = None
         self.late = False  # answered after it was given up on
+        self.sends = 0  # times the packet went out (a resend is answered again)
         self._event = threading.Event()
 
     @property
@@ -96,6 +99,7 @@ class ReplyMatcher(PacketListener):
         self._lock = threading.Lock()
         self._pending: dict[int, PendingReply] = {}
         self._given_up: OrderedDict[int, PendingReply] = OrderedDict()
+        self._resent: OrderedDict[tuple[int, tuple[int, int] | None], int] = OrderedDict()  # replies still due
         self._paired_by_command: deque[tuple[int, tuple[int, int] | None]] = \
             deque(maxlen=PAIRED_BY_COMMAND_KEPT)  # (SEQ, reply key) of requests paired by command
 
@@ -115,6 +119,7 @@ class ReplyMatcher(PacketListener):
     def expect(self, waiter: PendingReply) -> None:
         """Wait for ``waiter``'s reply (again, for a retry that was not yet answered)."""
         with self._lock:
+            waiter.sends += 1
             self._pending.setdefault(waiter.seq, waiter)
 
     def cancel(self, waiter: PendingReply) -> None:
@@ -173,6 +178,9 @@ class ReplyMatcher(PacketListener):
                 given_up = self._given_up.get(packet.seq)
                 if given_up is not None and given_up.answered_by(packet, key):
                     self._late(given_up, packet)
+                    self._expect_duplicates(given_up, key)
+                    return None
+                if self._duplicate(packet.seq, key):
                     return None
                 waiter = next((w for w in self._pending.values() if w.answered_by(packet, key)), None)
                 if waiter is None and (packet.seq, key) in self._paired_by_command:
@@ -184,7 +192,30 @@ class ReplyMatcher(PacketListener):
                 del self._pending[waiter.seq]
                 if not echoed:
                     self._paired_by_command.append((waiter.seq, key))
+                else:
+                    self._expect_duplicates(waiter, key)
             return waiter
+
+    def _expect_duplicates(self, waiter: PendingReply, key: tuple[int, int] | None) -> None:
+        """An answered request that went out more than once is answered once more for each resend
+        (the final stop is resent until answered): those replies are expected (lock held)."""
+        if waiter.sends > 1:
+            self._resent[(waiter.seq, key)] = waiter.sends - 1
+            while len(self._resent) > RESENT_KEPT:
+                self._resent.popitem(last=False)
+
+    def _duplicate(self, seq: int, key: tuple[int, int] | None) -> bool:
+        """A reply to a resend of a request already answered (``duplicate_replies``): dropped
+        without counting as a gimbal that does not echo SEQs (lock held)."""
+        due = self._resent.get((seq, key), 0)
+        if not due:
+            return False
+        if due == 1:
+            del self._resent[(seq, key)]
+        else:
+            self._resent[(seq, key)] = due - 1
+        self.stats["duplicate_replies"] += 1
+        return True
 
     def _late(self, waiter: PendingReply, packet: Packet) -> None:
         """A reply to a request given up on: it echoes that request's SEQ. The request is marked

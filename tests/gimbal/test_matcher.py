@@ -62,6 +62,26 @@ def test_a_retry_keeps_its_seq_and_an_answer_to_either_attempt_completes_it(matc
     assert matcher.stats["stale_replies"] == 1
 
 
+def test_the_replies_to_a_stops_resends_never_answer_the_next_stop(matcher: ReplyMatcher) -> None:
+    """The final stop is resent until answered, and a slow gimbal answers every copy: those extra
+    replies are duplicates, not evidence that it stopped echoing SEQs, so the release sent next
+    is not paired with one of them, and nobody is blamed for a misattribution."""
+    _feed(matcher, _reply(SpeedControlReply(0), _submit(matcher, SpeedControl()).seq))  # echoing learnt
+    stop = _submit(matcher, SpeedControl())
+    for _ in range(ECHO_EVIDENCE):
+        matcher.expect(stop)  # resent
+    _feed(matcher, _reply(SpeedControlReply(0), stop.seq))
+    release = _submit(matcher, SpeedControl())
+    for _ in range(ECHO_EVIDENCE):
+        _feed(matcher, _reply(SpeedControlReply(0), stop.seq))
+    assert not release.done and matcher.seq_echoed
+    assert matcher.stats["duplicate_replies"] == ECHO_EVIDENCE
+    _feed(matcher, _reply(SpeedControlReply(0), release.seq))
+    assert release.done and matcher.stats["misattributed_replies"] == 0
+    _feed(matcher, _reply(SpeedControlReply(0), stop.seq))  # one more than was sent: stale again
+    assert matcher.stats["duplicate_replies"] == ECHO_EVIDENCE and matcher.stats["stale_replies"] == ECHO_EVIDENCE + 1
+
+
 def test_a_late_reply_is_counted_late_and_never_answers_a_newer_request(matcher: ReplyMatcher) -> None:
     old = _submit(matcher, SpeedControl())
     matcher.cancel(old)  # timed out

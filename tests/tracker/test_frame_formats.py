@@ -18,6 +18,8 @@ from tracker.registry import make_tracker
 from tracker.synthetic import render_sequence
 
 FORMATS = ("grey", "grey x 1", "bgr", "bgra")
+RANDOMISED_BACKENDS = {"mil"}
+RANDOMISED_RUNS = 3
 
 
 def _as(frame: np.ndarray, fmt: str) -> np.ndarray:
@@ -95,12 +97,19 @@ def test_every_backend_runs_on_every_frame_format(name, fmt, fake_models):
 @pytest.mark.parametrize("fmt", FORMATS)
 @pytest.mark.parametrize("name", [n for n in BACKEND_NAMES if n not in MODEL_BACKENDS])
 def test_every_model_free_backend_follows_the_target_in_every_frame_format(name, fmt):
+    """MIL samples at random from more than OpenCV's seeded RNG and loses this target in about one
+    run in a hundred, in any format; it gets three runs, which a mishandled format fails alike."""
     seq = render_sequence(frames=12, speed=3.0, seed=3)
-    backend = make_backend(name)
-    backend.init(_as(seq.frames[0], fmt), seq.boxes[0])
-    for frame in seq.frames[1:]:
-        box, _ = backend.update(_as(frame, fmt))
-    assert box is not None and iou(box, seq.boxes[-1]) > 0.6
+    overlaps = []
+    for _ in range(RANDOMISED_RUNS if name in RANDOMISED_BACKENDS else 1):
+        backend = make_backend(name)
+        backend.init(_as(seq.frames[0], fmt), seq.boxes[0])
+        for frame in seq.frames[1:]:
+            box, _ = backend.update(_as(frame, fmt))
+        overlaps.append(0.0 if box is None else iou(box, seq.boxes[-1]))
+        if overlaps[-1] > 0.6:
+            break
+    assert max(overlaps) > 0.6, overlaps
 
 
 @pytest.mark.parametrize("fmt", FORMATS)
