@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 from gimbal.keepalive import DEFAULT_MAX_AGE_S
 from gimbal.messages.limits import MAX_SPEED_DPS
@@ -23,12 +23,19 @@ if TYPE_CHECKING:
     from gimbal.other_hosts import OtherHostsSeen
     from gimbal.watchdog import BusHealth
     from gimbal.keepalive import SpeedStreamer
-    from pipelines.control.controller import RateCommand
 
 #: The keep-alive streams zero once a setpoint is this old (the controller restarts from rest then).
 SETPOINT_MAX_AGE_S = DEFAULT_MAX_AGE_S
 #: The document's speed command range, ± this many °/s (every setpoint is clamped into it).
 PROTOCOL_MAX_SPEED_DPS = MAX_SPEED_DPS
+
+
+class Rates(Protocol):
+    """What the link streams: a controller's yaw/pitch setpoint in °/s (its ``RateCommand``),
+    named here so that the link does not import the controller that imports it."""
+
+    yaw_dps: float
+    pitch_dps: float
 
 
 @dataclass(frozen=True)
@@ -93,7 +100,7 @@ class GimbalLink:
         """The newest attitude as the gimbal reported it (its own signs)."""
         return self.history.latest()
 
-    def send(self, command: RateCommand, stamp: float | None = None) -> None:
+    def send(self, command: Rates, stamp: float | None = None) -> None:
         """Stream ``command``'s yaw/pitch rates in the gimbal's signs; ``stamp``: the capture time
         of the frame behind it (for the latency figures)."""
         if self._streamer is None:
