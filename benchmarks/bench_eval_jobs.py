@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from machine import describe_machine
-from tracker.data_paths import shared_sequences
+from tracker.evaluation.data_paths import shared_sequences
 
 ROOT = Path(__file__).resolve().parents[1]
 

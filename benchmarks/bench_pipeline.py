@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 from machine import describe_machine  # noqa: E402
 from pipelines.cli import main  # noqa: E402
 from pipelines.outputs.telemetry import read_telemetry  # noqa: E402
-from tracker.data_paths import shared_data_dir  # noqa: E402
+from tracker.evaluation.data_paths import shared_data_dir  # noqa: E402
 
 REALTIME_MS = 1000.0 / 30.0
 

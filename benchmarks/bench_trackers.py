@@ -19,12 +19,12 @@ import numpy as np
 
 from machine import describe_machine
 from tracker.backends import TrackingBackend, make_backend
-from tracker.boxes import Box
-from tracker.data_paths import shared_data_dir, shared_sequences
-from tracker.datasets import Sequence, load_sequence
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.boxes import Box
+from tracker.evaluation.data_paths import shared_data_dir, shared_sequences
+from tracker.evaluation.datasets import Sequence, load_sequence
+from tracker.runtime.estimate import TargetEstimate, TrackState
 from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
-from tracker.registry import EMBEDDED_TRACKER, make_tracker
+from tracker.runtime.registry import EMBEDDED_TRACKER, make_tracker
 
 BASELINE = "opencv-csrt"
 ONNX_MODELS = ("nanotrack3", "vittrack", "fear")  # each runs plain and inside the subject tracker

@@ -10,7 +10,7 @@ import can
 import pytest
 
 from tests.gimbal.scripted_peer import ScriptedPeer
-from tracker.data_paths import DATA_ENV, shared_data_dir
+from tracker.evaluation.data_paths import DATA_ENV, shared_data_dir
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -1,18 +1,19 @@
 """Vision tracker: detectors, tracking backends, re-acquisition, box Kalman, datasets, metrics.
 
 The names below are loaded on first use (module ``__getattr__``): importing a light module such as
-``tracker.boxes`` does not load the backends' OpenCV and SciPy."""
+``tracker.runtime.boxes`` does not load the backends' OpenCV and SciPy."""
 from __future__ import annotations
 
 import importlib
 from typing import TYPE_CHECKING, Any
 
-_HOMES = {"SubjectTracker": "subject", "available_trackers": "registry", "make_tracker": "registry"}
+_HOMES = {"SubjectTracker": "runtime.subject", "available_trackers": "runtime.registry",
+          "make_tracker": "runtime.registry"}
 __all__ = sorted(_HOMES)
 
 if TYPE_CHECKING:
-    from tracker.registry import available_trackers, make_tracker
-    from tracker.subject import SubjectTracker
+    from tracker.runtime.registry import available_trackers, make_tracker
+    from tracker.runtime.subject import SubjectTracker
 
 
 def __getattr__(name: str) -> Any:

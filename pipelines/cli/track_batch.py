@@ -18,7 +18,7 @@ from pipelines.batch import BatchError, Outcome, run_batch
 from pipelines.cli.batch_options import batch_jobs
 from pipelines.cli.bus import SIM_INTERFACE, choose_track_bus
 from pipelines.cli.common import EXIT_INTERRUPTED, CliError
-from pipelines.progress import ProgressReporter
+from pipelines.outputs.progress import ProgressReporter
 
 PROG = "gimbaltrack track"
 

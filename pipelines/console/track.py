@@ -13,7 +13,7 @@ from pipelines.console.server import ConsoleServer
 from pipelines.console.sink import ConsoleSink
 
 if TYPE_CHECKING:
-    from pipelines.track_session import TrackSession
+    from pipelines.loop.track_session import TrackSession
 
 
 @contextmanager

@@ -14,7 +14,7 @@ from pipelines.control.direction import Direction, DirectionFilter, PredictionTr
 from pipelines.control.gimbal_link import SETPOINT_MAX_AGE_S
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate
 from pipelines.control.pid import Pid
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 @dataclass(frozen=True, slots=True)

@@ -24,9 +24,9 @@ if TYPE_CHECKING:
     from pipelines.loop.recording import Recorder
     from pipelines.loop.sinks import Sink
     from pipelines.sources import Frame
-    from tracker.boxes import Box
+    from tracker.runtime.boxes import Box
     from tracker.detectors import Detection
-    from tracker.estimate import TargetEstimate
+    from tracker.runtime.estimate import TargetEstimate
 
 T = TypeVar("T")
 Note = dict[str, Any]

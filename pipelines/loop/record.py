@@ -12,7 +12,7 @@ if TYPE_CHECKING:
     from pipelines.control.attitude import Attitude
     from pipelines.control.controller import RateCommand
     from tracker.detectors import Detection
-    from tracker.estimate import TargetEstimate
+    from tracker.runtime.estimate import TargetEstimate
 
 #: ``FrameRecord.state`` before the subject is chosen (no estimate yet).
 ACQUIRING = "acquiring"

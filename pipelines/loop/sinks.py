@@ -214,7 +214,7 @@ class ProgressSink:
     name = "progress"
 
     def __init__(self, total: int | None, enabled: bool = True) -> None:
-        from pipelines.progress import ProgressReporter
+        from pipelines.outputs.progress import ProgressReporter
         self.reporter = ProgressReporter(total, enabled=enabled)
         self.frames = 0
 

@@ -11,7 +11,7 @@ from types import TracebackType
 import cv2
 import numpy as np
 
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 #: Container suffix -> FourCC, both FFmpeg's MPEG-4 part 2 encoder (about twice as fast as Motion JPEG
 #: at 720p, files several times smaller). An .mp4 is finalised by ``close()``; an .avi stays readable up

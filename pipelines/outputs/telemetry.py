@@ -9,7 +9,7 @@ from types import TracebackType
 from typing import Any
 
 from pipelines.outputs._files import to_plain
-from tracker.estimate import TargetEstimate
+from tracker.runtime.estimate import TargetEstimate
 
 #: What ``json.dumps(..., separators=(",", ":"), allow_nan=False)`` builds on every call.
 _ENCODER = json.JSONEncoder(separators=(",", ":"), allow_nan=False)

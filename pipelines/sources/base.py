@@ -9,7 +9,7 @@ from types import TracebackType
 import cv2
 import numpy as np
 
-from tracker.datasets import ASSUMED_FPS
+from tracker.evaluation.datasets import ASSUMED_FPS
 
 
 class SourceError(Exception):

@@ -12,9 +12,9 @@ import cv2
 import numpy as np
 
 from pipelines.sources.base import Frame, FrameSource, SourceError, nominal_fps
-from tracker.datasets import ASSUMED_FPS, FRAME_DIRS, frame_folder, list_images
+from tracker.evaluation.datasets import ASSUMED_FPS, FRAME_DIRS, frame_folder, list_images
 
-#: The image files an image folder source reads (a subset of what tracker.datasets lists).
+#: The image files an image folder source reads (a subset of what tracker.evaluation.datasets lists).
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
 
 

@@ -6,7 +6,7 @@ from pathlib import Path
 import cv2
 import pytest
 
-from tracker.synthetic import render_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ import numpy as np
 from pipelines.control.camera import CameraModel
 from pipelines.control.controller import Controller
 from pipelines.control.direction import relative, wrap_deg
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 PLANT_STEP = 0.001
 Subject = Callable[[float], tuple[float, float]]  # time -> world (yaw, pitch), degrees

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from pipelines.closed_loop import LoopSettings, run_closed_loop
+from pipelines.loop.closed_loop import LoopSettings, run_closed_loop
 
 FAST = LoopSettings(out_size=(480, 270), fps=60.0)  # oracle detections
 

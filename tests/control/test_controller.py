@@ -14,7 +14,7 @@ from pipelines.control.controller import (
 )
 from pipelines.control.direction import Direction, DirectionFilter, relative, wrap_deg
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS, limit_rate
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 CAM = CameraModel(640, 360)

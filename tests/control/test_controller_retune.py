@@ -5,7 +5,7 @@ import pytest
 
 from pipelines.control.camera import CameraModel
 from pipelines.control.controller import ControlConfig, make_controller
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 CAM = CameraModel(640, 360)
 

@@ -6,8 +6,8 @@ from pathlib import Path
 import cv2
 import pytest
 
-from pipelines.closed_loop import LoopSettings, run_closed_loop
-from tracker.synthetic import render_sequence
+from pipelines.loop.closed_loop import LoopSettings, run_closed_loop
+from tracker.evaluation.synthetic import render_sequence
 
 
 @pytest.fixture(scope="module")

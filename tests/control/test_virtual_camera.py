@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from pipelines.control.metrics import MAX_ERROR
-from pipelines.virtual_camera import VirtualCamera
+from pipelines.sources.virtual_camera import VirtualCamera
 
 
 def _dot_frame(x, y):

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipelines.acquire import StartConfirmer, check_roi_in_frame, parse_roi, pick_candidate
+from pipelines.loop.acquire import StartConfirmer, check_roi_in_frame, parse_roi, pick_candidate
 from tracker.detectors import Detection
 
 

@@ -12,7 +12,7 @@ import pytest
 from pipelines.control.controller import RateCommand
 from pipelines.loop import OPERATOR_STOP, FrameRecord, Loop, Recorder
 from pipelines.sources import Frame
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 class Subject:

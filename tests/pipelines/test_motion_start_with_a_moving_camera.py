@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import pytest
 
-from pipelines.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
-from tracker.boxes import Box, iou
+from pipelines.loop.acquire import CAMERA_MOTION_FRACTION, StartConfirmer, pick_candidate
+from tracker.runtime.boxes import Box, iou
 from tracker.detectors import make_detector
-from tracker.synthetic import SyntheticSequence, render_sequence
+from tracker.evaluation.synthetic import SyntheticSequence, render_sequence
 
 SIZE = (640, 360)
 CAMERAS = {

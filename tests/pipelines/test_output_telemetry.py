@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pipelines.outputs.telemetry import TelemetryWriter, estimate_fields, read_telemetry
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 def test_lines_survive_a_crash_before_close(tmp_path: Path, run_and_crash: Callable[[str], None]) -> None:

@@ -13,7 +13,7 @@ from pipelines.outputs.annotated_video import (
 )
 from pipelines.sources import open_source
 from tests.support import wait_until
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 def _estimate(index: int, state: TrackState = TrackState.TRACKING) -> TargetEstimate:

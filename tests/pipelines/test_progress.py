@@ -6,8 +6,8 @@ from types import SimpleNamespace
 
 import pytest
 
-import pipelines.progress
-from pipelines.progress import ProgressReporter
+import pipelines.outputs.progress
+from pipelines.outputs.progress import ProgressReporter
 
 
 def test_callable_status_is_called_only_when_drawn() -> None:
@@ -46,7 +46,7 @@ class _Terminal(io.StringIO):
 def clock(monkeypatch: pytest.MonkeyPatch) -> list[float]:
     """The reporter's clock: set ``clock[0]`` to move it."""
     now = [100.0]
-    monkeypatch.setattr(pipelines.progress, "time", SimpleNamespace(monotonic=lambda: now[0]))
+    monkeypatch.setattr(pipelines.outputs.progress, "time", SimpleNamespace(monotonic=lambda: now[0]))
     return now
 
 

@@ -99,7 +99,7 @@ def test_image_folder_in_natural_order(tmp_path: Path, frame_image) -> None:
 
 
 def test_image_folder_reads_only_jpg_and_png_files(tmp_path: Path, frame_image) -> None:
-    """Other image types tracker.datasets lists (.bmp, .tif, .webp) and folders are left out."""
+    """Other image types tracker.evaluation.datasets lists (.bmp, .tif, .webp) and folders are left out."""
     cv2.imwrite(str(tmp_path / "1.jpeg"), frame_image(0))
     cv2.imwrite(str(tmp_path / "2.bmp"), frame_image(1))
     cv2.imwrite(str(tmp_path / "3.tif"), frame_image(2))

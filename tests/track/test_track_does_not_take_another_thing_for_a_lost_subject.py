@@ -7,7 +7,7 @@ from pathlib import Path
 
 from pipelines.outputs.telemetry import read_telemetry
 from tests.track.helpers import BOX, SIZE, make_clip, out_right_and_back, run_track
-from tracker.boxes import Box
+from tracker.runtime.boxes import Box
 
 BACK_AT = 60  # the frame where the subject starts to come back in from the right
 

@@ -18,11 +18,11 @@ import gimbal.sim
 import pipelines.cli.bus
 import pipelines.cli.track_cmd
 import pipelines.outputs.plot
-import pipelines.track_session
+import pipelines.loop.track_session
 from gimbal.client import GimbalClient
 from gimbal.errors import ReturnCodeError
 from gimbal.sim import Faults
-from pipelines.acquire import AcquiringSubject
+from pipelines.loop.acquire import AcquiringSubject
 from pipelines.outputs.telemetry import TelemetryWriter, read_telemetry
 from tests import fake_onnx
 from tests.support import ROOT, cli_command, free_udp_port, subprocess_env, wait_until
@@ -415,14 +415,14 @@ def test_an_output_that_cannot_be_opened_is_one_line(tmp_path: Path, capsys: pyt
 # error and exit 1, the gimbal stopped first, and the previous rewrite left in place.
 def test_a_final_summary_that_cannot_be_written_is_one_line_and_exit_1(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
-    real = pipelines.track_session.write_summary
+    real = pipelines.loop.track_session.write_summary
 
     def full_at_the_end(path: Path, summary: dict[str, Any], sync: bool = True) -> None:
         if sync:  # the final rewrite; those during the run pass sync=False
             raise OSError(errno.ENOSPC, "No space left on device")
         real(path, summary, sync)
 
-    monkeypatch.setattr(pipelines.track_session, "write_summary", full_at_the_end)
+    monkeypatch.setattr(pipelines.loop.track_session, "write_summary", full_at_the_end)
 
     clip = make_clip(tmp_path / "clip.avi", 12, drifting)
     out = tmp_path / "out"

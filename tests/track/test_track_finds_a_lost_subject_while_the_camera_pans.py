@@ -9,8 +9,8 @@ import numpy as np
 from pipelines.outputs.telemetry import read_telemetry
 from tests.support import write_clip
 from tests.track.helpers import BOX, run_track
-from tracker.boxes import iou
-from tracker.synthetic import texture
+from tracker.runtime.boxes import iou
+from tracker.evaluation.synthetic import texture
 
 SIZE = (680, 360)  # wide enough that the template search around where it was lost does not reach
 FRAMES, GONE, BACK = 130, 40, 90

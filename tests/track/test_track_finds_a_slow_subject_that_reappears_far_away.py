@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pipelines.outputs.telemetry import read_telemetry
 from tests.track.helpers import BOX, make_clip, run_track
-from tracker.boxes import iou
+from tracker.runtime.boxes import iou
 
 SIZE = (680, 360)  # wide enough that the template search around where it was lost does not reach
 GONE, BACK = 40, 90

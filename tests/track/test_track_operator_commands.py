@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from pipelines.track_session import TrackSession
+from pipelines.loop.track_session import TrackSession
 from tests.track.helpers import DEMO, DEMO_ROI, assert_stopped_at_end, decoded, run_track
 
 

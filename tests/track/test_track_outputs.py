@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-import pipelines.track_session
+import pipelines.loop.track_session
 from pipelines.outputs.telemetry import read_telemetry
 from tests.track.helpers import decoded, drifting, make_clip, roi_at, run_track, speed_commands
 
@@ -21,14 +21,14 @@ from tests.track.helpers import decoded, drifting, make_clip, roi_at, run_track,
 # seconds), the frame rate, what a file announces and drops, and the angular error.
 def test_latency_is_in_milliseconds_and_fps_is_frames_over_elapsed(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    real = pipelines.track_session.latency_percentiles
+    real = pipelines.loop.track_session.latency_percentiles
     in_seconds: list[dict[str, Any]] = []
 
     def kept(latencies: Iterable[float]) -> dict[str, Any]:
         in_seconds.append(real(latencies))
         return in_seconds[-1]
 
-    monkeypatch.setattr(pipelines.track_session, "latency_percentiles", kept)
+    monkeypatch.setattr(pipelines.loop.track_session, "latency_percentiles", kept)
 
     def position(i: int) -> tuple[int, int]:
         return 140 + i, 100
@@ -65,14 +65,14 @@ def test_angular_error_is_over_the_frames_with_a_subject_only(tmp_path: Path) ->
 # one), cheaply (no fsync) while running, and synced once at the end.
 def test_the_summary_is_written_while_running_and_synced_at_the_end(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    real = pipelines.track_session.write_summary
+    real = pipelines.loop.track_session.write_summary
     written: list[tuple[str, int, bool]] = []
 
     def recorded(path: Path, summary: dict[str, Any], sync: bool = True) -> None:
         written.append((summary["status"], summary["frames"], sync))
         real(path, summary, sync)
 
-    monkeypatch.setattr(pipelines.track_session, "write_summary", recorded)
+    monkeypatch.setattr(pipelines.loop.track_session, "write_summary", recorded)
 
     def position(i: int) -> tuple[int, int]:
         return 140 + i, 100
@@ -133,12 +133,12 @@ def test_json_prints_the_summary_as_written(tmp_path: Path, capsys: pytest.Captu
 
 def test_a_run_without_a_latency_reports_none(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                               monkeypatch: pytest.MonkeyPatch) -> None:
-    real = pipelines.track_session.latency_percentiles
+    real = pipelines.loop.track_session.latency_percentiles
 
     def none_measured(latencies: Iterable[float]) -> dict[str, Any]:
         return real([])
 
-    monkeypatch.setattr(pipelines.track_session, "latency_percentiles", none_measured)
+    monkeypatch.setattr(pipelines.loop.track_session, "latency_percentiles", none_measured)
     clip = make_clip(tmp_path / "clip.avi", 5, drifting)
     assert run_track(clip, tmp_path / "out", "--roi", roi_at(drifting), "--no-video") == 0
     report = capsys.readouterr().out

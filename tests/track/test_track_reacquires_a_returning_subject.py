@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-import pipelines.track_session
+import pipelines.loop.track_session
 from pipelines.outputs.telemetry import read_telemetry
 from tests.track.helpers import BOX, make_clip, out_right_and_back, run_track
 
@@ -21,7 +21,7 @@ _position = out_right_and_back(BACK_AT, 100)
 def test_the_detector_runs_only_without_a_subject_and_finds_it_again(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     calls = {"detect": 0, "init": 0}
-    make_detector, make_tracker = pipelines.track_session.make_detector, pipelines.track_session.make_tracker
+    make_detector, make_tracker = pipelines.loop.track_session.make_detector, pipelines.loop.track_session.make_tracker
 
     def counted(name: str, target: Any) -> Any:
         real = getattr(target, name)
@@ -33,8 +33,8 @@ def test_the_detector_runs_only_without_a_subject_and_finds_it_again(
         setattr(target, name, call)
         return target
 
-    monkeypatch.setattr(pipelines.track_session, "make_detector", lambda *a: counted("detect", make_detector(*a)))
-    monkeypatch.setattr(pipelines.track_session, "make_tracker", lambda *a: counted("init", make_tracker(*a)))
+    monkeypatch.setattr(pipelines.loop.track_session, "make_detector", lambda *a: counted("detect", make_detector(*a)))
+    monkeypatch.setattr(pipelines.loop.track_session, "make_tracker", lambda *a: counted("init", make_tracker(*a)))
     clip = make_clip(tmp_path / "back.avi", 90, _position)
     assert run_track(clip, tmp_path / "out", "--detect", "motion", "--no-video") == 0
     records = read_telemetry(tmp_path / "out" / "telemetry.jsonl")

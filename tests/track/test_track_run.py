@@ -17,7 +17,7 @@ from pipelines.cli.app import build_parser
 from pipelines.control import ControlConfig
 from pipelines.control.gimbal_link import Signs
 from pipelines.outputs.telemetry import read_telemetry
-from pipelines.track_session import TrackOptions
+from pipelines.loop.track_session import TrackOptions
 from tests.support import require_ffmpeg
 from tests.track.helpers import (
     DEMO, DEMO_ROI, SIZE, assert_stopped_at_end, decoded, host_commands, in_speed_range, make_clip, roi_at,

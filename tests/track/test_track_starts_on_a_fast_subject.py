@@ -11,7 +11,7 @@ import pytest
 
 from pipelines.outputs.telemetry import read_telemetry
 from tests.track.helpers import BOX, make_clip, run_track
-from tracker.boxes import iou
+from tracker.runtime.boxes import iou
 
 SIZE = (640, 360)
 FIRST_DETECTED = 2  # the motion detector needs three frames

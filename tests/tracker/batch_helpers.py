@@ -7,7 +7,7 @@ from pathlib import Path
 import cv2
 
 from pipelines.batch import Outcome
-from tracker.synthetic import render_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 def write_otb(folder: Path, frames: int, seed: int) -> Path:

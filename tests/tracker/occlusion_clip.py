@@ -4,8 +4,8 @@ import itertools
 import cv2
 import numpy as np
 
-from tracker.appearance import AppearanceModel, cut_patch
-from tracker.datasets import load_sequence
+from tracker.runtime.appearance import AppearanceModel, cut_patch
+from tracker.evaluation.datasets import load_sequence
 
 
 def shared_frame(shared_data, name: str, index: int) -> tuple[np.ndarray, tuple[float, ...]]:

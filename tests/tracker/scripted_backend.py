@@ -6,11 +6,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from tracker.boxes import Box
+from tracker.runtime.boxes import Box
 from tracker.detectors import Detection, Detector
-from tracker.estimate import TargetEstimate, TrackState
-from tracker.subject import SubjectTracker, TrackerSettings
-from tracker.synthetic import SyntheticSequence, texture
+from tracker.runtime.estimate import TargetEstimate, TrackState
+from tracker.runtime.subject import SubjectTracker, TrackerSettings
+from tracker.evaluation.synthetic import SyntheticSequence, texture
 
 FPS = 30.0
 Answer = tuple[Box | None, float]

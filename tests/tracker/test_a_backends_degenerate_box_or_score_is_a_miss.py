@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from tests.tracker.scripted_backend import Answer, follow, scripted_tracker
-from tracker.boxes import Box
-from tracker.estimate import TrackState
-from tracker.synthetic import render_sequence
+from tracker.runtime.boxes import Box
+from tracker.runtime.estimate import TrackState
+from tracker.evaluation.synthetic import render_sequence
 
 SEQ = render_sequence(frames=12, seed=4)
 GLITCH = range(4, 8)  # the frames the backend answers oddly; it follows the subject on the others

@@ -8,11 +8,11 @@ from __future__ import annotations
 import numpy as np
 
 from tests.tracker.scripted_backend import FPS
-from tracker.appearance import AppearanceModel
-from tracker.boxes import Box, iou
-from tracker.estimate import TrackState
-from tracker.subject import SubjectTracker
-from tracker.synthetic import texture
+from tracker.runtime.appearance import AppearanceModel
+from tracker.runtime.boxes import Box, iou
+from tracker.runtime.estimate import TrackState
+from tracker.runtime.subject import SubjectTracker
+from tracker.evaluation.synthetic import texture
 
 SUBJECT: Box = (60.0, 100.0, 40.0, 40.0)
 LOOK_ALIKE: Box = (140.0, 100.0, 40.0, 40.0)

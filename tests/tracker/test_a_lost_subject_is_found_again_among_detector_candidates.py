@@ -4,8 +4,8 @@ the template search's reach."""
 from __future__ import annotations
 
 from tests.tracker.scripted_backend import BackgroundAndSubject, restarted_by_detection, wide_scene
-from tracker.boxes import iou
-from tracker.estimate import TrackState
+from tracker.runtime.boxes import iou
+from tracker.runtime.estimate import TrackState
 
 BEFORE, AFTER = (100.0, 220.0, 40.0, 40.0), (520.0, 220.0, 40.0, 40.0)  # 420 px apart: past max_reach
 ELSEWHERE = (300.0, 60.0, 40.0, 40.0)  # a patch of background

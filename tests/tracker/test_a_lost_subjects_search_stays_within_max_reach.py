@@ -4,7 +4,7 @@ picture (with a detector, candidates are what may take it further)."""
 from __future__ import annotations
 
 from tests.tracker.scripted_backend import follow, scripted_tracker, wide_scene
-from tracker.estimate import TrackState
+from tracker.runtime.estimate import TrackState
 
 HERE, FAR = (100.0, 220.0, 40.0, 40.0), (520.0, 220.0, 40.0, 40.0)  # 420 px (10.5 box sizes) apart
 GONE = 5

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from tracker.detectors import make_detector
-from tracker.registry import DEFAULT_BACKEND, make_tracker
+from tracker.runtime.registry import DEFAULT_BACKEND, make_tracker
 
 
 @pytest.fixture(params=["missing", "file"])

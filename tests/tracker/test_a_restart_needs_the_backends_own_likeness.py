@@ -6,10 +6,10 @@ from __future__ import annotations
 import pytest
 
 from tests.tracker.scripted_backend import ScriptedBackend, follow, gives_up, on_truth
-from tracker.boxes import Box
-from tracker.estimate import TrackState
-from tracker.subject import SubjectTracker
-from tracker.synthetic import render_sequence
+from tracker.runtime.boxes import Box
+from tracker.runtime.estimate import TrackState
+from tracker.runtime.subject import SubjectTracker
+from tracker.evaluation.synthetic import render_sequence
 
 GIVES_UP_AT = 8  # the backend answers nothing from this frame until it is restarted
 

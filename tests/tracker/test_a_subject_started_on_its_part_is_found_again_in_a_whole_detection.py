@@ -6,8 +6,8 @@ does not qualify."""
 from __future__ import annotations
 
 from tests.tracker.scripted_backend import BackgroundAndSubject, restarted_by_detection, wide_scene
-from tracker.boxes import iou
-from tracker.estimate import TrackState
+from tracker.runtime.boxes import iou
+from tracker.runtime.estimate import TrackState
 
 PART = (100.0, 220.0, 20.0, 40.0)  # the left half of the 40 px subject at (100, 220)
 WHOLE_AFTER = (520.0, 220.0, 40.0, 40.0)  # the whole subject, 420 px away: past max_reach

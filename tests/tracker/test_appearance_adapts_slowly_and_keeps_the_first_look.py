@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from tests.tracker.scripted_backend import empty_scene, follow, gives_up, scripted_tracker
-from tracker.appearance import AppearanceModel, cut_patch
-from tracker.estimate import TrackState
-from tracker.synthetic import texture
+from tracker.runtime.appearance import AppearanceModel, cut_patch
+from tracker.runtime.estimate import TrackState
+from tracker.evaluation.synthetic import texture
 
 BOX = (140.0, 100.0, 40.0, 40.0)
 FRAMES = 90

@@ -1,8 +1,8 @@
 """The box filter's start, its stop on a loss and how hard a measurement pulls it."""
 import pytest
 
-from tracker.boxes import center
-from tracker.kalman import BoxKalman
+from tracker.runtime.boxes import center
+from tracker.runtime.kalman import BoxKalman
 
 
 def _moving_filter() -> BoxKalman:

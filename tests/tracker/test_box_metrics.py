@@ -5,12 +5,12 @@ import math
 import cv2
 import pytest
 
-from tracker.boxes import iou, polygon_to_box
-from tracker.datasets import Sequence
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.boxes import iou, polygon_to_box
+from tracker.evaluation.datasets import Sequence
+from tracker.runtime.estimate import TargetEstimate, TrackState
 from tracker.evaluation import PERTURBED_STARTS, perturbed_box, run_sequence, summarize
-from tracker.metrics import SUCCESS_THRESHOLDS, has_truth, precision_at, success_auc, success_curve
-from tracker.synthetic import render_sequence
+from tracker.evaluation.metrics import SUCCESS_THRESHOLDS, has_truth, precision_at, success_auc, success_curve
+from tracker.evaluation.synthetic import render_sequence
 
 
 def test_iou_hand_cases():

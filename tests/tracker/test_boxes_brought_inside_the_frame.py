@@ -3,7 +3,7 @@ the OpenCV trackers start on, so they start on the subject's visible part, not o
 it); ``clip_to_frame`` moves the whole box inside, keeping its size."""
 from __future__ import annotations
 
-from tracker.boxes import clip_to_frame, cut_to_frame
+from tracker.runtime.boxes import clip_to_frame, cut_to_frame
 
 WIDTH, HEIGHT = 320, 240
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tracker.colour_model import box_response
+from tracker.backends.colour_model import box_response
 
 
 def test_a_half_covered_cell_counts_one_half() -> None:

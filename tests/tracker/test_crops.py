@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from tracker.crops import resample_window
+from tracker.runtime.crops import resample_window
 
 
 @pytest.mark.parametrize("center, size", [((40.0, 30.0), (50.0, 50.0)), ((50.3, 37.8), (80.0, 40.0)),

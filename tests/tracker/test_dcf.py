@@ -4,12 +4,12 @@ import math
 import numpy as np
 import pytest
 
-from tracker.boxes import iou
-from tracker.colour_model import ColourModel, box_response, colour_index
-from tracker.correlation import ScaleFilter, TranslationFilter, gaussian_peak
-from tracker.dcf import DcfBackend, DcfSettings
-from tracker.features import CELL, CHANNELS, SIGNED_BINS, cell_features
-from tracker.synthetic import render_sequence, texture
+from tracker.runtime.boxes import iou
+from tracker.backends.colour_model import ColourModel, box_response, colour_index
+from tracker.backends.correlation import ScaleFilter, TranslationFilter, gaussian_peak
+from tracker.backends.dcf import DcfBackend, DcfSettings
+from tracker.backends.features import CELL, CHANNELS, SIGNED_BINS, cell_features
+from tracker.evaluation.synthetic import render_sequence, texture
 
 
 def test_features_have_one_row_per_cell_and_image():

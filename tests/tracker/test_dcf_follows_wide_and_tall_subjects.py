@@ -5,9 +5,9 @@ from __future__ import annotations
 import cv2
 import pytest
 
-from tracker.boxes import iou
-from tracker.dcf import DcfBackend
-from tracker.synthetic import render_sequence
+from tracker.runtime.boxes import iou
+from tracker.backends.dcf import DcfBackend
+from tracker.evaluation.synthetic import render_sequence
 
 
 @pytest.mark.parametrize("stretch", [(2, 1), (1, 2)], ids=["wide", "tall"])

@@ -4,9 +4,9 @@ there put it on look-alike background (dtb70_mountainbike6 at frame 26, docs/tra
 from __future__ import annotations
 
 from tests.tracker.scripted_backend import ScriptedBackend, follow, gives_up, on_truth
-from tracker.estimate import TrackState
-from tracker.registry import make_tracker
-from tracker.synthetic import render_sequence
+from tracker.runtime.estimate import TrackState
+from tracker.runtime.registry import make_tracker
+from tracker.evaluation.synthetic import render_sequence
 
 GIVES_UP_AT = 8
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tracker.boxes import center
-from tracker.dcf import DcfBackend
-from tracker.synthetic import render_sequence
+from tracker.runtime.boxes import center
+from tracker.backends.dcf import DcfBackend
+from tracker.evaluation.synthetic import render_sequence
 
 
 def test_a_slowly_moving_subject_is_located_to_about_a_pixel() -> None:

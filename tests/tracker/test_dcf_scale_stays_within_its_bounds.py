@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from tracker.dcf import DcfBackend, DcfSettings
-from tracker.synthetic import render_sequence
+from tracker.backends.dcf import DcfBackend, DcfSettings
+from tracker.evaluation.synthetic import render_sequence
 
 
 @pytest.mark.parametrize("change, bound", [(1.6, "max"), (0.5, "min")])

@@ -6,9 +6,9 @@ import cv2
 import numpy as np
 import pytest
 
-from tracker.boxes import iou
+from tracker.runtime.boxes import iou
 from tracker.detectors import Detection, HaarFaceDetector, make_detector
-from tracker.synthetic import render_sequence, texture
+from tracker.evaluation.synthetic import render_sequence, texture
 
 
 def test_motion_finds_the_moving_target_once_it_has_three_frames():

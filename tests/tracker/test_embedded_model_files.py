@@ -9,8 +9,8 @@ import pytest
 from tests import fake_onnx
 from tests.support import cli_command
 from tests.tracker.test_eval_cli import write_otb
-from tracker import registry
-from tracker.registry import EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
+from tracker.runtime import registry
+from tracker.runtime.registry import EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
 
 
 def test_nanotrack3_runs_on_the_embedded_model_files_with_their_licence():

@@ -3,7 +3,7 @@ from pathlib import Path
 
 import pytest
 
-from tracker.datasets import parse_groundtruth
+from tracker.evaluation.datasets import parse_groundtruth
 
 
 @pytest.mark.parametrize("text", ["", "\n", " \r\n\n"], ids=["empty", "one-blank-line", "blank-lines-crlf"])

@@ -1,7 +1,7 @@
 """``TargetEstimate.found``: the subject is in hand only while it is tracked."""
 import pytest
 
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 @pytest.mark.parametrize("state", list(TrackState))

@@ -15,8 +15,8 @@ from pipelines.cli.eval_cmd import score_all
 from tests import fake_onnx
 from tests.support import cli_command, signalled
 from tests.tracker.batch_helpers import scores, write_otb
-from tracker.datasets import load_sequence
-from tracker.synthetic import render_sequence
+from tracker.evaluation.datasets import load_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 def gimbaltrack(*argv: str) -> subprocess.CompletedProcess:

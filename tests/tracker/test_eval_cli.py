@@ -9,7 +9,7 @@ import pytest
 
 from tests import fake_onnx
 from tests.support import cli_command, signalled, write_clip
-from tracker.synthetic import render_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 def gimbaltrack(argv: list[str]) -> subprocess.CompletedProcess:

@@ -11,11 +11,11 @@ import pytest
 
 from tests import fake_onnx
 from tracker.backends import BACKEND_NAMES, MODEL_BACKENDS, make_backend
-from tracker.boxes import iou
+from tracker.runtime.boxes import iou
 from tracker.detectors import DETECTOR_KINDS, Detection, make_detector
-from tracker.estimate import TrackState
-from tracker.registry import make_tracker
-from tracker.synthetic import render_sequence
+from tracker.runtime.estimate import TrackState
+from tracker.runtime.registry import make_tracker
+from tracker.evaluation.synthetic import render_sequence
 
 FORMATS = ("grey", "grey x 1", "bgr", "bgra")
 RANDOMISED_BACKENDS = {"mil"}

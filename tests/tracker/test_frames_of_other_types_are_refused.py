@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tracker.detectors import make_detector
-from tracker.registry import make_tracker
+from tracker.runtime.registry import make_tracker
 
 BGR = np.random.default_rng(3).integers(0, 255, (120, 160, 3), dtype=np.uint8)
 BAD = {"float32": BGR.astype(np.float32), "uint16": BGR.astype(np.uint16), "two channels": BGR[:, :, :2],

@@ -4,7 +4,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from tracker.metrics import center_errors, has_truth, overlaps
+from tracker.evaluation.metrics import center_errors, has_truth, overlaps
 
 
 @pytest.mark.parametrize("box", [(3.0, 4.0, 10.0, 0.0), (3.0, 4.0, 0.0, 0.0), (3.0, 4.0, -1.0, 10.0)])

@@ -1,7 +1,7 @@
 """IoU of boxes that overlap along one axis only."""
 import pytest
 
-from tracker.boxes import iou
+from tracker.runtime.boxes import iou
 
 
 @pytest.mark.parametrize("other", [(2.0, 30.0, 10.0, 10.0), (30.0, 2.0, 10.0, 10.0), (-30.0, -2.0, 10.0, 10.0)])

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from filterpy.common import Q_discrete_white_noise
 
-from tracker.kalman import BoxKalman, white_noise_q
+from tracker.runtime.kalman import BoxKalman, white_noise_q
 
 
 @pytest.mark.parametrize("dt, var", [(1 / 30, 1.0), (0.004, 9e4), (0.5, 2.5)])

@@ -3,9 +3,9 @@ and a confident frame or a (re)start counts them afresh."""
 from __future__ import annotations
 
 from tests.tracker.scripted_backend import empty_scene, follow, scripted_tracker
-from tracker.boxes import Box
-from tracker.estimate import TargetEstimate, TrackState
-from tracker.synthetic import render_sequence
+from tracker.runtime.boxes import Box
+from tracker.runtime.estimate import TargetEstimate, TrackState
+from tracker.evaluation.synthetic import render_sequence
 
 SEQ = render_sequence(frames=12, seed=0)
 EMPTY = empty_scene(0)  # SEQ's scene without its subject

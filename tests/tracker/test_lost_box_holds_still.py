@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from tests.tracker.scripted_backend import empty_scene, follow, scripted_tracker
-from tracker.estimate import TrackState
-from tracker.synthetic import render_sequence
+from tracker.runtime.estimate import TrackState
+from tracker.evaluation.synthetic import render_sequence
 
 GONE_AT = 8  # moving right and down at about 2.4 px a frame when it vanishes
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tracker.metrics import center_errors, overlaps, precision_at, success_auc
+from tracker.evaluation.metrics import center_errors, overlaps, precision_at, success_auc
 
 NAN = float("nan")
 TRUTH = [(0.0, 0.0, 10.0, 10.0), (NAN, NAN, NAN, NAN), (5.0, 5.0, 10.0, 10.0), (40.0, 0.0, 10.0, 10.0)]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tracker.detectors import Detection, make_detector
-from tracker.synthetic import texture
+from tracker.evaluation.synthetic import texture
 
 RNG = np.random.default_rng(12)
 BIG, SMALL = texture(40, 40, RNG, cell=5, contrast=1.0), texture(20, 20, RNG, cell=4, contrast=1.0)

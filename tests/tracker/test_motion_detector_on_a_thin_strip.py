@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tracker.camera_motion import camera_motion
+from tracker.detectors.camera_motion import camera_motion
 from tracker.detectors import MotionDetector
 
 

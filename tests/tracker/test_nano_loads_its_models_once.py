@@ -11,7 +11,7 @@ import pytest
 
 from tests import fake_onnx
 from tracker.backends import make_backend
-from tracker.synthetic import render_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 def test_each_model_file_is_loaded_once_however_often_the_backend_restarts(

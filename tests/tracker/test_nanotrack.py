@@ -4,17 +4,17 @@ import cv2
 import numpy as np
 import pytest
 
-from tracker.boxes import iou
-from tracker.estimate import TrackState
-from tracker.metrics import success_auc
+from tracker.runtime.boxes import iou
+from tracker.runtime.estimate import TrackState
+from tracker.evaluation.metrics import success_auc
 from tests import fake_onnx
 from tracker.backends import make_backend
-from tracker.nanotrack import (SCORE_SIZE, NanoTrackBackend, NanoTrackParams, change_penalty, cosine_likeness,
+from tracker.backends.nanotrack import (SCORE_SIZE, NanoTrackBackend, NanoTrackParams, change_penalty, cosine_likeness,
                                crop_square, decode_boxes, foreground_score, grid_offsets, hanning_window,
                                load_nanotrack_networks, sample_cells, select_peak)
-from tracker.subject import SubjectTracker
+from tracker.runtime.subject import SubjectTracker
 from tests.tracker.occlusion_clip import lookalike_occlusion
-from tracker.synthetic import render_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 def test_hanning_window_peaks_in_the_middle_and_vanishes_on_the_border():

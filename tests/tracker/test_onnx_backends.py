@@ -6,13 +6,13 @@ import pytest
 
 from tests import fake_onnx
 from tracker.backends import make_backend
-from tracker.boxes import center
-from tracker.estimate import TrackState
-from tracker.fear import FearBackend, decode_best, grid_points
-from tracker.onnx_sessions import OnnxNetwork
-from tracker.registry import make_tracker
-from tracker.subject import SubjectTracker
-from tracker.vittrack import VitTrackBackend, centred_hann, decode_peak, normalised_blob
+from tracker.runtime.boxes import center
+from tracker.runtime.estimate import TrackState
+from tracker.backends.fear import FearBackend, decode_best, grid_points
+from tracker.backends.onnx_sessions import OnnxNetwork
+from tracker.runtime.registry import make_tracker
+from tracker.runtime.subject import SubjectTracker
+from tracker.backends.vittrack import VitTrackBackend, centred_hann, decode_peak, normalised_blob
 
 MODELS = ("vittrack", "fear", "nanotrack3")
 SIDE = 32

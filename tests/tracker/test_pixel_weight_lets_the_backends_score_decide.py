@@ -3,8 +3,8 @@ confidence (a turning subject's pixels stop matching its first look while a mode
 import numpy as np
 
 from tests.tracker.scripted_backend import ScriptedBackend
-from tracker.estimate import TrackState
-from tracker.subject import SubjectTracker, TrackerSettings
+from tracker.runtime.estimate import TrackState
+from tracker.runtime.subject import SubjectTracker, TrackerSettings
 
 BOX = (100.0, 80.0, 40.0, 40.0)
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from tests.tracker.scripted_backend import follow, scripted_tracker
-from tracker.boxes import center
-from tracker.estimate import TrackState
-from tracker.synthetic import render_sequence
+from tracker.runtime.boxes import center
+from tracker.runtime.estimate import TrackState
+from tracker.evaluation.synthetic import render_sequence
 
 OFFSET = 3.0  # px right of the subject (its size 40: within refine_reach's 4 px)
 

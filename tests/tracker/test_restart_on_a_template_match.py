@@ -5,9 +5,9 @@ not, and its weak box still steers the estimate."""
 from __future__ import annotations
 
 from tests.tracker.scripted_backend import Answer, follow, gives_up, on_truth, scripted_tracker
-from tracker.boxes import Box, iou
-from tracker.estimate import TargetEstimate, TrackState
-from tracker.synthetic import render_sequence
+from tracker.runtime.boxes import Box, iou
+from tracker.runtime.estimate import TargetEstimate, TrackState
+from tracker.evaluation.synthetic import render_sequence
 
 GIVES_UP_AT = 8  # the backend answers nothing from this frame until it is restarted
 REACQUIRE_AFTER = 3  # TrackerSettings.reacquire_after_frames

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from tracker import evaluation
-from tracker.boxes import Box
-from tracker.datasets import ASSUMED_FPS, Sequence
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.boxes import Box
+from tracker.evaluation.datasets import ASSUMED_FPS, Sequence
+from tracker.runtime.estimate import TargetEstimate, TrackState
 from tracker.evaluation import run_sequence
-from tracker.synthetic import render_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 def _sequence(folder: Path, frames: int) -> Sequence:

@@ -3,8 +3,8 @@ import cv2
 import numpy as np
 import pytest
 
-from tracker.scale_estimator import ScaleEstimator
-from tracker.synthetic import texture
+from tracker.backends.scale_estimator import ScaleEstimator
+from tracker.evaluation.synthetic import texture
 
 
 def zoomed(image: np.ndarray, factor: float) -> np.ndarray:

@@ -5,7 +5,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tracker.datasets import FrameReadError, list_images, load_sequence, parse_groundtruth
+from tracker.evaluation.datasets import FrameReadError, list_images, load_sequence, parse_groundtruth
 
 
 def _write_frames(folder: Path, count: int, name: str = "{:04d}.jpg") -> None:

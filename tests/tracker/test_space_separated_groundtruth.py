@@ -1,7 +1,7 @@
 """Ground truth written with spaces between the values."""
 from pathlib import Path
 
-from tracker.datasets import parse_groundtruth
+from tracker.evaluation.datasets import parse_groundtruth
 
 
 def test_space_separated_boxes_and_polygons(tmp_path: Path) -> None:

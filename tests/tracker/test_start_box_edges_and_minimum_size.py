@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from tracker.boxes import Box, start_box
+from tracker.runtime.boxes import Box, start_box
 
 WIDTH, HEIGHT = 320, 240
 

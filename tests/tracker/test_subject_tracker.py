@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 
-from tracker.registry import available_trackers, make_tracker
-from tracker.boxes import center, iou
-from tracker.estimate import TrackState
-from tracker.metrics import success_auc
-from tracker.synthetic import render_sequence, texture
+from tracker.runtime.registry import available_trackers, make_tracker
+from tracker.runtime.boxes import center, iou
+from tracker.runtime.estimate import TrackState
+from tracker.evaluation.metrics import success_auc
+from tracker.evaluation.synthetic import render_sequence, texture
 
 FPS = 30.0
 
@@ -118,7 +118,7 @@ class _GlitchingBackend:
 
 
 def test_a_backends_numerical_failure_is_a_miss_not_a_measurement():
-    from tracker.subject import SubjectTracker
+    from tracker.runtime.subject import SubjectTracker
 
     seq = render_sequence(frames=30, seed=4)
     subject = SubjectTracker("glitching", _GlitchingBackend(seq.boxes))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tracker import make_tracker
-from tracker.synthetic import render_sequence
+from tracker.evaluation.synthetic import render_sequence
 
 
 @pytest.mark.parametrize("timestamp", [None, math.nan, math.inf, "0.1", True])

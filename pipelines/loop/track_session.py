@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 from gimbal.errors import GimbalError
 from gimbal.signals import deferred_signals
 from gimbal.watchdog import DEFAULT_TIMEOUT_S
-from pipelines.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartConfirmer
+from pipelines.loop.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartConfirmer
 from pipelines.control import CameraModel, ControlConfig, make_controller
 from pipelines.control.gimbal_link import GimbalLink, Signs
 from pipelines.control.tuning import settings_of

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from tracker.boxes import Box, center
+from tracker.runtime.boxes import Box, center
 
 
 class TrackState(str, Enum):

@@ -7,13 +7,13 @@ from numbers import Real
 
 import numpy as np
 
-from tracker.appearance import AppearanceModel, Match, cut_patch
+from tracker.runtime.appearance import AppearanceModel, Match, cut_patch
 from tracker.backends import TrackingBackend
-from tracker.boxes import Box, start_box
-from tracker.frames import as_bgr_or_grey
+from tracker.runtime.boxes import Box, start_box
+from tracker.runtime.frames import as_bgr_or_grey
 from tracker.detectors import Detector
-from tracker.estimate import TargetEstimate, TrackState
-from tracker.kalman import BoxKalman
+from tracker.runtime.estimate import TargetEstimate, TrackState
+from tracker.runtime.kalman import BoxKalman
 
 
 #: A backend's box narrower or lower than this is a failure, not a subject (``_usable``).

@@ -15,7 +15,7 @@ import numpy as np
 from pipelines.control.camera import CameraModel
 from pipelines.control.direction import rotation_matrix
 from pipelines.control.metrics import MAX_ERROR
-from tracker.boxes import Box, center
+from tracker.runtime.boxes import Box, center
 
 # (forward, right, up) -> OpenCV camera axes (x right, y down, z forward)
 _TO_CV = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])

@@ -14,10 +14,10 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from tracker import camera_motion
-from tracker.boxes import Box
-from tracker.frames import as_bgr, as_bgr_or_grey, as_grey, check_frame
-from tracker.model_files import checked_model_dir, find_model_file
+from tracker.detectors import camera_motion
+from tracker.runtime.boxes import Box
+from tracker.runtime.frames import as_bgr, as_bgr_or_grey, as_grey, check_frame
+from tracker.backends.model_files import checked_model_dir, find_model_file
 
 DETECTOR_KINDS = ("face", "person", "motion")
 HAAR_FACE = "haarcascade_frontalface_default.xml"
@@ -129,7 +129,7 @@ class MotionDetector:
     until the ground behind it has been seen. Foreground in which nothing moved for
     ``ADOPT_FRAMES`` frames (the ground a thing left, edges after the camera shook) becomes
     background. When the camera moved between two frames (panned, turned on a gimbal, shaken in the
-    hand; :func:`tracker.camera_motion.camera_motion`), the earlier frames and the background are
+    hand; :func:`tracker.detectors.camera_motion.camera_motion`), the earlier frames and the background are
     first carried into the new frame's pixels, and the strip at the edge that they did not see
     says nothing. A change over more than ``restart_fraction`` of the picture (the light, a camera
     motion that could not be told) or of the frame size starts afresh. The score is the blob's

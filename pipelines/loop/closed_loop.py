@@ -6,7 +6,7 @@ Runs in real time (the client's keep-alive and the simulator run on the wall clo
 is captured (rendered at the simulator's true attitude), handed to the tracker ``latency_s``
 later, and the setpoint goes out through the ``SpeedStreamer``; the ground truth in the view
 gives the centring error of every frame that has one. A frame without ground truth (a NaN box,
-or width or height not above 0, as ``tracker.metrics.has_truth``) is left out of the scores and
+or width or height not above 0, as ``tracker.evaluation.metrics.has_truth``) is left out of the scores and
 is no detection for the oracle; the tracker sees its rendered view as any other.
 """
 from __future__ import annotations
@@ -28,14 +28,14 @@ from pipelines.control.gimbal_link import GimbalLink
 from pipelines.control.metrics import CentringSample, summarize
 from pipelines.loop import Loop, Sink
 from pipelines.sources import Frame
-from pipelines.virtual_camera import VirtualCamera
+from pipelines.sources.virtual_camera import VirtualCamera
 from tracker import SubjectTracker, make_tracker
-from tracker.boxes import Box, center, start_box
-from tracker.datasets import Sequence, load_sequence
+from tracker.runtime.boxes import Box, center, start_box
+from tracker.evaluation.datasets import Sequence, load_sequence
 from tracker.detectors import Detection
-from tracker.estimate import TargetEstimate, TrackState
+from tracker.runtime.estimate import TargetEstimate, TrackState
 from tracker.evaluation import first_box
-from tracker.metrics import has_truth
+from tracker.evaluation.metrics import has_truth
 
 if TYPE_CHECKING:
     import can

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tracker.boxes import Box, center, clip_to_frame, from_center
-from tracker.frames import as_grey
+from tracker.runtime.boxes import Box, center, clip_to_frame, from_center
+from tracker.runtime.frames import as_grey
 
 TEMPLATE_PX = 32
 

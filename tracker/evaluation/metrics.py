@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from tracker.boxes import Box, center, iou
+from tracker.runtime.boxes import Box, center, iou
 
 PRECISION_PX = 20.0
 SUCCESS_THRESHOLDS = np.round(np.arange(0.0, 1.0001, 0.05), 2)

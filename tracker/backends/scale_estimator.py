@@ -9,8 +9,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tracker.correlation import ScaleFilter
-from tracker.features import CELL, cell_features, unit_grey
+from tracker.backends.correlation import ScaleFilter
+from tracker.backends.features import CELL, cell_features, unit_grey
 
 
 class ScaleEstimator:

@@ -5,10 +5,10 @@ from pathlib import Path
 
 from tracker.backends import BACKEND_NAMES, MODEL_BACKENDS, make_backend
 from tracker.detectors import Detector
-from tracker.model_files import checked_model_dir
-from tracker.nanotrack import nanotrack_model_files
-from tracker.onnx_sessions import DEFAULT_THREADS
-from tracker.subject import SubjectTracker, TrackerSettings
+from tracker.backends.model_files import checked_model_dir
+from tracker.backends.nanotrack import nanotrack_model_files
+from tracker.backends.onnx_sessions import DEFAULT_THREADS
+from tracker.runtime.subject import SubjectTracker, TrackerSettings
 
 #: The default: the correlation filter. NanoTrack v3 scores higher on the 19 shared sequences
 #: (docs/tracker.md) but on the suite's rendered occlusion clips it goes on saying "tracking" after
@@ -17,7 +17,7 @@ DEFAULT_BACKEND = "dcf"
 DEFAULT_WITH_MODELS = "nanotrack"  # the default when the model folder holds NanoTrack v2's files
 #: The model tracker whose files ship inside the package, so that it needs no model folder.
 EMBEDDED_TRACKER = "nanotrack3"
-EMBEDDED_MODELS = Path(__file__).resolve().parent / "models"
+EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # The template refinement corrects CSRT's drift; the correlation filter's own peak is finer. The
 # template search may restart dcf only once the subject is lost: dcf keeps following through a few
 # unsure frames, and restarting it there put it on look-alike background (docs/tracker.md).

@@ -12,7 +12,7 @@ import functools
 import cv2
 import numpy as np
 
-from tracker.frames import as_grey
+from tracker.runtime.frames import as_grey
 
 CELL = 4
 SIGNED_BINS = 18

@@ -6,14 +6,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from tracker.boxes import Box, center, iou
+from tracker.runtime.boxes import Box, center, iou
 
 if TYPE_CHECKING:  # the tracker and detectors load OpenCV and SciPy: only a run needs them
     import numpy as np
 
     from tracker.detectors import Detection, Detector
-    from tracker.estimate import TargetEstimate
-    from tracker.subject import SubjectTracker
+    from tracker.runtime.estimate import TargetEstimate
+    from tracker.runtime.subject import SubjectTracker
 
 PICKS = ("central", "largest")
 CAMERA_MOTION_FRACTION = 0.10  # motion over more of the frame than this: the camera moved

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tracker.boxes import Box
+from tracker.runtime.boxes import Box
 
 
 @dataclass(frozen=True)

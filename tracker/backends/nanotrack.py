@@ -22,10 +22,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tracker.boxes import Box, from_center
-from tracker.crops import resample_window
-from tracker.model_files import find_model_file
-from tracker.onnx_sessions import DEFAULT_THREADS, OnnxNetwork
+from tracker.runtime.boxes import Box, from_center
+from tracker.runtime.crops import resample_window
+from tracker.backends.model_files import find_model_file
+from tracker.backends.onnx_sessions import DEFAULT_THREADS, OnnxNetwork
 
 EXEMPLAR_SIZE = 127  # template crop side, pixels
 INSTANCE_SIZE = 255  # search crop side, pixels

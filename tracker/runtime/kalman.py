@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-from tracker.boxes import Box, center, from_center
+from tracker.runtime.boxes import Box, center, from_center
 
 # State: cx, cy, vx, vy, w, h (pixels, pixels per second). Measurement: cx, cy, w, h.
 _MEASURE = np.array([[1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 0, 0, 1, 0], [0, 0, 0, 0, 0, 1]], float)
