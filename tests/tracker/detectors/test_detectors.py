@@ -1,4 +1,6 @@
 """Detectors: motion on rendered frames; face and person construct and run."""
+from __future__ import annotations
+
 import subprocess
 import sys
 
@@ -6,9 +8,10 @@ import cv2
 import numpy as np
 import pytest
 
-from tracker.runtime.boxes import iou
-from tracker.detectors import Detection, HaarFaceDetector, make_detector
+from tracker.detectors import Detection, HaarFaceDetector, HogPersonDetector, MotionDetector, make_detector
+from tracker.detectors.camera_motion import camera_motion
 from tracker.evaluation.synthetic import render_sequence, texture
+from tracker.runtime.boxes import iou
 
 
 def test_motion_finds_the_moving_target_once_it_has_three_frames():
@@ -167,3 +170,112 @@ def test_hog_finds_people_in_the_pets_clip(shared_data):
     assert ok
     found = make_detector("person").detect(frame)
     assert found and all(d.box[3] > d.box[2] for d in found)  # upright boxes
+
+
+# An empty frame (no pixels) gives no candidates, for the motion and face detectors as for the
+# person detector (whose case runs in a child process in test_detectors.py).
+@pytest.mark.parametrize("kind", ["motion", "face"])
+@pytest.mark.parametrize("shape", [(0, 0, 3), (0, 5), (5, 0, 4)])
+def test_an_empty_frame_gives_nothing(kind: str, shape: tuple[int, ...]) -> None:
+    assert make_detector(kind).detect(np.zeros(shape, np.uint8)) == []
+
+
+# The OpenCV face and person detectors' answers as candidates: boxes in the frame's own pixels
+# (the person detector works on frames shrunk to 640 px) and the best candidate first. OpenCV's own
+# detectors are replaced by stand-ins with known answers (the synthetic frames hold no faces or people).
+class _Hog:
+    """Stands in for ``cv2.HOGDescriptor``: two people, in the pixels of the image it is given."""
+
+    winSize = (64, 128)
+
+    def __init__(self) -> None:
+        self.shapes: list[tuple[int, ...]] = []
+
+    def detectMultiScale(self, image: np.ndarray, **options: object) -> tuple[np.ndarray, np.ndarray]:
+        self.shapes.append(image.shape)
+        return np.array([[10, 20, 64, 128], [300, 40, 80, 160]]), np.array([[-0.5], [1.5]])
+
+
+class _Cascade:
+    """Stands in for ``cv2.CascadeClassifier``: two faces, the second merged from more raw hits."""
+
+    def detectMultiScale2(self, image: np.ndarray, **options: object) -> tuple[np.ndarray, np.ndarray]:
+        return np.array([[10, 10, 30, 30], [100, 50, 40, 40]]), np.array([3, 12])
+
+
+def test_person_boxes_are_in_the_frames_pixels_and_best_first(monkeypatch: pytest.MonkeyPatch) -> None:
+    detector = HogPersonDetector()
+    hog = _Hog()
+    monkeypatch.setattr(detector, "_hog", hog)
+    found = detector.detect(np.zeros((720, 1280, 3), np.uint8))
+    assert hog.shapes == [(360, 640, 3)]  # shrunk by 2
+    assert [d.box for d in found] == [(600.0, 80.0, 160.0, 320.0), (20.0, 40.0, 128.0, 256.0)]
+    assert found[0].score > found[1].score
+
+
+def test_faces_are_best_first(monkeypatch: pytest.MonkeyPatch) -> None:
+    detector = HaarFaceDetector()
+    monkeypatch.setattr(detector, "_cascade", _Cascade())
+    found = detector.detect(np.zeros((240, 320, 3), np.uint8))
+    assert [d.box for d in found] == [(100.0, 50.0, 40.0, 40.0), (10.0, 10.0, 30.0, 30.0)]
+    assert 0.0 < found[1].score < found[0].score < 1.0
+
+
+# The motion detector's blobs: a moving speck smaller than ``min_area_fraction`` of the picture is
+# not a candidate, and each blob's score is its share of the moving area.
+RNG = np.random.default_rng(12)
+BIG, SMALL = texture(40, 40, RNG, cell=5, contrast=1.0), texture(20, 20, RNG, cell=4, contrast=1.0)
+
+
+def _last_detections(speck: int = 0) -> list[Detection]:
+    """What a motion detector reports on the fourth frame of a grey scene where a 40 px square moves
+    12 px a frame, with either a 20 px square or (``speck`` > 0) a white speck of that side moving too."""
+    detector = make_detector("motion")
+    found: list[Detection] = []
+    for i in range(4):
+        frame = np.full((240, 320, 3), 128, np.uint8)
+        frame[100:140, 40 + 12 * i:80 + 12 * i] = BIG
+        if speck:
+            frame[20 + 6 * i:20 + 6 * i + speck, 250:250 + speck] = 255
+        else:
+            frame[180:200, 200 + 10 * i:220 + 10 * i] = SMALL
+        found = detector.detect(frame)
+    return found
+
+
+def test_a_moving_speck_is_not_a_candidate() -> None:
+    found = _last_detections(speck=3)  # a few dozen moving pixels at most, under 0.05 % of 320 x 240
+    assert len(found) == 1 and 60 < found[0].box[0] < 80
+
+
+def test_each_blob_scores_its_share_of_the_moving_area() -> None:
+    big, small = _last_detections()
+    assert big.score + small.score == pytest.approx(1.0)
+    assert big.score / small.score == pytest.approx(big.box[2] * big.box[3] / (small.box[2] * small.box[3]), rel=0.3)
+
+
+# A frame only a pixel or two high once worked on (a wide strip: 1000 x 2 shrinks to 640 x 1):
+# the camera-motion fit, which halves images over 400 px, cannot halve it and must not fail.
+@pytest.mark.parametrize("shape", [(1, 1000, 3), (2, 1000, 3), (1000, 1, 3)])
+def test_the_motion_detector_takes_a_thin_strip(shape: tuple[int, int, int]) -> None:
+    rng = np.random.default_rng(0)
+    detector = MotionDetector()
+    for _ in range(4):  # a still camera worked on these before the camera-motion fit came
+        assert isinstance(detector.detect(rng.integers(0, 256, shape, dtype=np.uint8)), list)
+
+
+def test_a_one_pixel_high_image_gives_no_camera_motion() -> None:
+    strip = np.random.default_rng(1).integers(0, 256, (1, 401), dtype=np.uint8)
+    assert camera_motion(strip, np.roll(strip, 3, axis=1)) is None
+
+
+# ``MotionDetector(settle_frames=...)`` takes 1..255 (a pixel's age is counted in a byte).
+@pytest.mark.parametrize("frames", [0, 256])
+def test_settle_frames_out_of_range_is_refused(frames: int) -> None:
+    with pytest.raises(ValueError, match="settle_frames must be 1..255"):
+        MotionDetector(settle_frames=frames)
+
+
+@pytest.mark.parametrize("frames", [1, 255])
+def test_settle_frames_at_the_ends_of_the_range_is_taken(frames: int) -> None:
+    MotionDetector(settle_frames=frames)

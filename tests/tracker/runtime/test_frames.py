@@ -5,17 +5,20 @@ detector's boxes, the model-free backends following the target); the face and pe
 find nothing on them and the NanoTrack backends run on stand-in networks, so for those the tests
 only show that every format is taken and answered within range (what they find is tested in
 test_detectors.py and test_nanotrack.py)."""
+from __future__ import annotations
+
 import cv2
 import numpy as np
 import pytest
 
 from tests import fake_onnx
 from tracker.backends import BACKEND_NAMES, MODEL_BACKENDS, make_backend
-from tracker.runtime.boxes import iou
 from tracker.detectors import DETECTOR_KINDS, Detection, make_detector
+from tracker.evaluation.synthetic import render_sequence
+from tracker.runtime.boxes import iou
 from tracker.runtime.estimate import TrackState
 from tracker.runtime.registry import make_tracker
-from tracker.evaluation.synthetic import render_sequence
+
 
 FORMATS = ("grey", "grey x 1", "bgr", "bgra")
 RANDOMISED_BACKENDS = {"mil"}
@@ -124,3 +127,30 @@ def test_every_tracker_follows_every_frame_format(name, fmt, fake_models):
     assert all(np.isfinite(e.box).all() for e in estimates)
     if name not in MODEL_BACKENDS:  # the stand-in networks see nothing; the real backends follow
         assert estimates[-1].state == TrackState.TRACKING and iou(tuple(estimates[-1].box), seq.boxes[-1]) > 0.6
+
+
+# A frame that is not grey, BGR or BGRA uint8 is a ValueError naming it, from every tracker and
+# detector, rather than an OpenCV error or a frame tracked as something else (KCF and MOSSE took
+# float32 frames as they were).
+BGR = np.random.default_rng(3).integers(0, 255, (120, 160, 3), dtype=np.uint8)
+BAD = {"float32": BGR.astype(np.float32), "uint16": BGR.astype(np.uint16), "two channels": BGR[:, :, :2],
+       "a list": BGR.tolist(), "None": None, "one row": BGR[0, :, 0]}
+BOX = (60.0, 40.0, 30.0, 30.0)
+
+
+@pytest.mark.parametrize("what", BAD)
+@pytest.mark.parametrize("name", ["default", "kcf", "mosse", "csrt"])
+def test_init_and_update_refuse_the_frame(name: str, what: str) -> None:
+    with pytest.raises(ValueError, match="a frame must be"):
+        make_tracker(name).init(BAD[what], BOX, 0.0)
+    tracker = make_tracker(name)
+    tracker.init(BGR, BOX, 0.0)
+    with pytest.raises(ValueError, match="a frame must be"):
+        tracker.update(BAD[what], 0.04)
+
+
+@pytest.mark.parametrize("what", BAD)
+@pytest.mark.parametrize("kind", ["face", "person", "motion"])
+def test_detectors_refuse_the_frame(kind: str, what: str) -> None:
+    with pytest.raises(ValueError, match="a frame must be"):
+        make_detector(kind).detect(BAD[what])

@@ -1,16 +1,22 @@
 """Hand-computed IoU, precision and success-AUC cases."""
+from __future__ import annotations
+
 import json
 import math
+from collections.abc import Callable
 
 import cv2
+import numpy as np
 import pytest
 
-from tracker.runtime.boxes import iou, polygon_to_box
+from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
 from tracker.evaluation.datasets import Sequence
-from tracker.runtime.estimate import TargetEstimate, TrackState
-from tracker.evaluation import PERTURBED_STARTS, perturbed_box, run_sequence, summarize
-from tracker.evaluation.metrics import SUCCESS_THRESHOLDS, has_truth, precision_at, success_auc, success_curve
+from tracker.evaluation.metrics import (
+    SUCCESS_THRESHOLDS, center_errors, has_truth, overlaps, precision_at, success_auc, success_curve,
+)
 from tracker.evaluation.synthetic import render_sequence
+from tracker.runtime.boxes import iou, polygon_to_box
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 def test_iou_hand_cases():
@@ -138,3 +144,58 @@ def test_summary_fps_is_the_median_of_the_measured_sequences(tmp_path):
     one = run_sequence(_Still(), _sequence_on_disk(tmp_path / "one", 1))
     three = run_sequence(_Still(), _sequence_on_disk(tmp_path, 3))
     assert summarize([one, three])["fps"] == round(three.fps, 1) > 0
+
+
+# IoU of boxes that overlap along one axis only.
+@pytest.mark.parametrize("other", [(2.0, 30.0, 10.0, 10.0), (30.0, 2.0, 10.0, 10.0), (-30.0, -2.0, 10.0, 10.0)])
+def test_boxes_apart_on_one_axis_do_not_overlap(other: tuple[float, float, float, float]) -> None:
+    """Side by side (or one above the other) with a shared span on the other axis: IoU is 0, not
+    the negative ratio a negative intersection height or width times a positive one would give."""
+    assert iou((0.0, 0.0, 10.0, 10.0), other) == 0.0
+    assert iou(other, (0.0, 0.0, 10.0, 10.0)) == 0.0
+
+
+# Boxes as N x 4 numpy arrays score the same as lists of tuples (an array's truth value was an
+# ambiguous-truth-value error from numpy).
+NAN = float("nan")
+TRUTH = [(0.0, 0.0, 10.0, 10.0), (NAN, NAN, NAN, NAN), (5.0, 5.0, 10.0, 10.0), (40.0, 0.0, 10.0, 10.0)]
+PREDICTED = [(0.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 10.0), (8.0, 5.0, 10.0, 10.0), (0.0, 0.0, 10.0, 10.0)]
+
+
+@pytest.mark.parametrize("score", [precision_at, success_auc])
+def test_arrays_score_as_lists(score) -> None:
+    assert score(np.array(PREDICTED), np.array(TRUTH)) == score(PREDICTED, TRUTH)
+
+
+@pytest.mark.parametrize("measure", [center_errors, overlaps])
+def test_arrays_measure_as_lists(measure) -> None:
+    np.testing.assert_array_equal(measure(np.array(PREDICTED), np.array(TRUTH)), measure(PREDICTED, TRUTH))
+
+
+def test_empty_arrays_are_refused_by_name() -> None:
+    with pytest.raises(ValueError, match="non-zero box counts"):
+        success_auc(np.zeros((0, 4)), np.zeros((0, 4)))
+
+
+# Which boxes count as ground truth, and per-frame figures of mismatched box lists.
+@pytest.mark.parametrize("box", [(3.0, 4.0, 10.0, 0.0), (3.0, 4.0, 0.0, 0.0), (3.0, 4.0, -1.0, 10.0)])
+def test_a_box_without_height_or_width_is_no_ground_truth(box: tuple[float, float, float, float]) -> None:
+    assert not has_truth(box)
+
+
+@pytest.mark.parametrize("figure", [center_errors, overlaps])
+def test_per_frame_figures_refuse_lists_of_different_lengths(figure: Callable[..., np.ndarray]) -> None:
+    """``zip`` would quietly drop the unmatched frames."""
+    with pytest.raises(ValueError, match="equal"):
+        figure([(0, 0, 10, 10)] * 3, [(0, 0, 10, 10)] * 2)
+    with pytest.raises(ValueError, match="equal"):
+        figure([(0, 0, 10, 10)], [(0, 0, 10, 10)] * 2)
+
+
+# The overall row of an evaluation: scores are means over the sequences.
+def test_precision_and_auc_are_means_not_medians() -> None:
+    results = [SequenceResult(f"s{i}", 10, prec, auc, 30.0, []) for i, (prec, auc) in
+               enumerate([(0.1, 0.05), (0.2, 0.1), (0.9, 0.75)])]
+    summary = summarize(results)
+    assert summary["sequences"] == 3
+    assert summary["prec20"] == pytest.approx(0.4) and summary["auc"] == pytest.approx(0.3)

@@ -1,12 +1,17 @@
-"""The subject's first box (``start_box``, used by ``SubjectTracker.init``): kept as given while it
-overlaps the frame by any amount, refused once it only touches an edge from outside, is not
-finite or has no width or height, and grown about its centre to 4 px a side when smaller."""
+"""Box geometry (tracker/runtime/boxes.py): the start box and boxes brought inside the frame."""
 from __future__ import annotations
 
 import pytest
 
-from tracker.runtime.boxes import Box, start_box
+from tracker.runtime.boxes import Box, clip_to_frame, cut_to_frame, start_box
 
+
+
+
+
+# The subject's first box (``start_box``, used by ``SubjectTracker.init``): kept as given while it
+# overlaps the frame by any amount, refused once it only touches an edge from outside, is not
+# finite or has no width or height, and grown about its centre to 4 px a side when smaller.
 WIDTH, HEIGHT = 320, 240
 
 
@@ -38,3 +43,18 @@ def test_a_box_without_width_or_height_is_refused(box: Box) -> None:
     """Once grown silently into a 4 px box (a swapped corner, x2 < x1, gave a tracker on nothing)."""
     with pytest.raises(ValueError, match="needs a width and height above 0"):
         start_box(box, WIDTH, HEIGHT)
+
+
+# Bringing a box inside the frame: ``cut_to_frame`` keeps the part of it that is in view (what
+# the OpenCV trackers start on, so they start on the subject's visible part, not on a patch beside
+# it); ``clip_to_frame`` moves the whole box inside, keeping its size.
+
+
+def test_cut_keeps_the_visible_part_of_a_box_over_an_edge() -> None:
+    assert cut_to_frame((-16.0, 50.0, 40.0, 40.0), WIDTH, HEIGHT) == (0.0, 50.0, 24.0, 40.0)
+    assert cut_to_frame((300.0, 220.0, 40.0, 40.0), WIDTH, HEIGHT) == (300.0, 220.0, 20.0, 20.0)
+
+
+def test_clip_moves_a_box_over_an_edge_inside_whole() -> None:
+    assert clip_to_frame((300.0, 220.0, 40.0, 40.0), WIDTH, HEIGHT) == (280.0, 200.0, 40.0, 40.0)
+    assert clip_to_frame((-16.0, -5.0, 40.0, 40.0), WIDTH, HEIGHT) == (0.0, 0.0, 40.0, 40.0)

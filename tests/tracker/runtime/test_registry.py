@@ -1,18 +1,26 @@
-"""NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir. The
-default stays the correlation filter (docs/tracker.md says why)."""
+"""Trackers and detectors built by name (tracker/runtime/registry.py): where their model files come from."""
+from __future__ import annotations
+
 import json
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 
 from tests import fake_onnx
 from tests.support import cli_command
-from tests.tracker.test_eval_cli import write_otb
+from tests.tracker.evaluation.test_eval_cli import write_otb
+from tracker.detectors import make_detector
 from tracker.runtime import registry
-from tracker.runtime.registry import EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
+from tracker.runtime.registry import DEFAULT_BACKEND, EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
 
 
+
+
+
+# NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir. The
+# default stays the correlation filter (docs/tracker.md says why).
 def test_nanotrack3_runs_on_the_embedded_model_files_with_their_licence():
     subject = make_tracker(EMBEDDED_TRACKER)
     assert subject.name == "nanotrack3" and subject.model == str(EMBEDDED_MODELS)
@@ -52,3 +60,30 @@ def test_eval_json_names_the_tracker_and_its_model(tmp_path):
     assert captured.returncode == 0, captured.stderr
     summary = json.loads(captured.stdout.splitlines()[-1])
     assert summary["tracker"] == "nanotrack3" and summary["model"] == str(EMBEDDED_MODELS)
+
+
+# A mistyped ``model_dir`` is a FileNotFoundError naming it, as ``--model-dir`` is on the command
+# line, rather than quietly meaning "no models" (the correlation filter, the Haar face detector).
+@pytest.fixture(params=["missing", "file"])
+def not_a_folder(request: pytest.FixtureRequest, tmp_path: Path) -> Path:
+    path = tmp_path / "models"
+    if request.param == "file":
+        path.write_text("")
+    return path
+
+
+def test_make_tracker_refuses_it(not_a_folder: Path) -> None:
+    with pytest.raises(FileNotFoundError, match="model directory .*models' is not a folder"):
+        make_tracker("default", model_dir=not_a_folder)
+
+
+@pytest.mark.parametrize("kind", ["face", "person", "motion"])
+def test_make_detector_refuses_it(kind: str, not_a_folder: Path) -> None:
+    with pytest.raises(FileNotFoundError, match="is not a folder"):
+        make_detector(kind, model_dir=str(not_a_folder))
+
+
+def test_a_folder_without_models_still_gives_the_defaults(tmp_path: Path) -> None:
+    # issue #23: the default's model ships with the package, so an empty folder leaves it on those files
+    assert make_tracker("default", model_dir=tmp_path).name == DEFAULT_BACKEND
+    assert type(make_detector("face", model_dir=tmp_path)).__name__ == "HaarFaceDetector"

@@ -13,7 +13,7 @@ from distributed import LocalCluster
 
 from pipelines.cli.eval_cmd import score_all
 from tests.support import cli_command, free_udp_port, subprocess_env
-from tests.tracker.batch_helpers import scores, write_otb
+from tests.tracker.evaluation.batch_helpers import scores, write_otb
 from tracker.evaluation.datasets import load_sequence
 
 

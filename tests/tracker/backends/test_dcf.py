@@ -1,15 +1,21 @@
 """The correlation-filter tracker's parts: cell features, filters, colour model, and the backend."""
+from __future__ import annotations
+
 import math
 
+import cv2
 import numpy as np
 import pytest
 
-from tracker.runtime.boxes import iou
+from tests.tracker.scripted_backend import ScriptedBackend, follow, gives_up, on_truth
 from tracker.backends.colour_model import ColourModel, box_response, colour_index
 from tracker.backends.correlation import ScaleFilter, TranslationFilter, gaussian_peak
 from tracker.backends.dcf import DcfBackend, DcfSettings
 from tracker.backends.features import CELL, CHANNELS, SIGNED_BINS, cell_features
 from tracker.evaluation.synthetic import render_sequence, texture
+from tracker.runtime.boxes import center, iou
+from tracker.runtime.estimate import TrackState
+from tracker.runtime.registry import make_tracker
 
 
 def test_features_have_one_row_per_cell_and_image():
@@ -237,3 +243,70 @@ def test_a_subject_differing_in_one_colour_channel_is_told_apart(channel: int) -
     foreground[5:15, 5:15] = True
     likelihood = _learnt_likelihood(patch, foreground)
     assert likelihood[10, 10] > 0.9 and likelihood[1, 1] < 0.1
+
+
+# ``box_response`` works on each feature cell's mean likelihood, not on one sampled pixel of it.
+def test_a_half_covered_cell_counts_one_half() -> None:
+    likelihood = np.zeros((8, 8), np.float32)
+    likelihood[0:4, 0:2] = 1.0  # the left half of the top-left 4 x 4 cell
+    np.testing.assert_allclose(box_response(likelihood, 4, (1, 1)), [[0.5, 0.0], [0.0, 0.0]])
+
+
+# The correlation filter follows subjects that are not square (a person is tall, a car wide): its
+# window is then not square either, and must be centred on each axis by that axis's size.
+@pytest.mark.parametrize("stretch", [(2, 1), (1, 2)], ids=["wide", "tall"])
+def test_a_stretched_subject_is_followed(stretch: tuple[int, int]) -> None:
+    sx, sy = stretch
+    seq = render_sequence(frames=30, target=40, speed=2.0, seed=3)
+    frames = [cv2.resize(frame, None, fx=sx, fy=sy, interpolation=cv2.INTER_LINEAR) for frame in seq.frames]
+    truth = [(x * sx, y * sy, w * sx, h * sy) for x, y, w, h in seq.boxes]
+    backend = DcfBackend()
+    backend.init(frames[0], truth[0])
+    assert min(iou(backend.update(frame)[0], box) for frame, box in zip(frames[1:], truth[1:])) > 0.8
+
+
+# The correlation filter places the subject finer than its 4 px feature cells (the parabolic
+# sub-cell peak): a subject creeping half a pixel a frame is followed to within about a pixel.
+def test_a_slowly_moving_subject_is_located_to_about_a_pixel() -> None:
+    seq = render_sequence(frames=40, target=40, speed=0.5, seed=3)
+    backend = DcfBackend()
+    backend.init(seq.frames[0], seq.boxes[0])
+    errors = [np.hypot(*np.subtract(center(backend.update(frame)[0]), center(truth)))
+              for frame, truth in zip(seq.frames[1:], seq.boxes[1:])]
+    assert np.mean(errors) < 1.2  # 1.7 px with whole cells only
+
+
+# The correlation filter's scale follows the subject only as far as ``min_scale`` and
+# ``max_scale`` (of its first size) allow.
+@pytest.mark.parametrize("change, bound", [(1.6, "max"), (0.5, "min")])
+def test_the_box_stops_at_the_scale_bound(change: float, bound: str) -> None:
+    seq = render_sequence(frames=40, target=40, speed=0.7, scale_change=change, seed=6)
+    settings = DcfSettings(min_scale=0.8, max_scale=1.2)
+    backend = DcfBackend(settings)
+    backend.init(seq.frames[0], seq.boxes[0])
+    widths = [backend.update(frame)[0][2] for frame in seq.frames[1:]]
+    if bound == "max":
+        assert 1.15 * 40 < max(widths) <= settings.max_scale * 40
+    else:
+        assert settings.min_scale * 40 <= min(widths) < 0.85 * 40
+
+
+# ``dcf``'s subject tracker restarts its backend on a template match only once the subject is lost:
+# through a few unsure frames the correlation filter usually stays on the subject, and restarting it
+# there put it on look-alike background (dtb70_mountainbike6 at frame 26, docs/tracker.md).
+GIVES_UP_AT = 8
+
+
+def test_an_unsure_dcf_is_not_restarted_until_the_subject_is_lost() -> None:
+    seq = render_sequence(frames=40, speed=2.0, seed=3)
+    subject = make_tracker("dcf")
+    backend = ScriptedBackend(gives_up(GIVES_UP_AT, on_truth(seq)))
+    subject._backend = backend
+    subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    estimates = follow(subject, seq.frames[1:])
+    lost_after = subject.settings.lost_after_frames
+    restart = GIVES_UP_AT + lost_after  # the first miss past lost_after_frames
+    assert backend.inits == [0, restart]
+    states = [e.state for e in estimates]
+    assert states[GIVES_UP_AT - 1:restart - 1] == [TrackState.SEARCHING] * lost_after
+    assert states[restart - 1] is TrackState.TRACKING

@@ -163,3 +163,18 @@ def test_shared_sequences_load(shared_data):
     video = load_sequence(shared_data / "clips/clip_vot_bag_video/bag.avi",
                           shared_data / "sequences/vot_bag/groundtruth.txt")
     assert len(video) == 196
+
+
+# A ground-truth file without a single box.
+@pytest.mark.parametrize("text", ["", "\n", " \r\n\n"], ids=["empty", "one-blank-line", "blank-lines-crlf"])
+def test_a_file_without_boxes_is_an_error(tmp_path: Path, text: str) -> None:
+    """An empty annotation would otherwise make a sequence of no frames."""
+    (tmp_path / "gt.txt").write_text(text)
+    with pytest.raises(ValueError, match="gt.txt: no ground-truth boxes"):
+        parse_groundtruth(tmp_path / "gt.txt")
+
+
+# Ground truth written with spaces between the values.
+def test_space_separated_boxes_and_polygons(tmp_path: Path) -> None:
+    (tmp_path / "gt.txt").write_text("1 2 3 4\n5  6 7 8\n1 1 5 1 5 4 1 4\n")
+    assert parse_groundtruth(tmp_path / "gt.txt") == ((1, 2, 3, 4), (5, 6, 7, 8), (1, 1, 4, 3))

@@ -14,7 +14,7 @@ import pytest
 from pipelines.cli.eval_cmd import score_all
 from tests import fake_onnx
 from tests.support import cli_command, signalled
-from tests.tracker.batch_helpers import scores, write_otb
+from tests.tracker.evaluation.batch_helpers import scores, write_otb
 from tracker.evaluation.datasets import load_sequence
 from tracker.evaluation.synthetic import render_sequence
 
