@@ -1,14 +1,14 @@
 """The stream framer: any chunking, garbage, truncation and CRC damage, never raising."""
 from __future__ import annotations
 
-from hypothesis import given, settings
-from hypothesis import strategies as st
+from hypothesis import given, settings, strategies as st
 
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.messages import message_packet
-from gimbal.messages.motion import AnglesReply, SpeedControl
+from gimbal.messages.motion import AnglesReply, SpeedControl, SpeedControlReply
 from gimbal.messages.telemetry import ParameterPush
-from gimbal.packet import Packet, decode_packet, encode_packet
+from gimbal.packet import MIN_PACKET_LEN, Packet, decode_packet, encode_packet
+
 
 DOC_EXAMPLE = bytes.fromhex("AA 1A 00 03 00 00 00 00 22 11 A2 42 0E 00 20 00 30 00 40 00 01 14 7B 40 97 BE")
 SPEED = encode_packet(message_packet(SpeedControl(100, 0, -20), 2))
@@ -178,3 +178,23 @@ def test_packets_survive_garbage_around_them(before: bytes, after: bytes, cuts: 
     # Garbage before the stream may swallow a packet only if it forms a packet header itself,
     # which random bytes essentially never do; the packets after it must all come out.
     assert packets(feed_all(chunks))[-4:] == PACKETS
+
+
+# The shortest packet the framer must recognise: 17 bytes, a legacy-layout reply carrying only its
+# return code (12-byte header, 1 DATA byte, CRC32), e.g. a NACK from older firmware.
+NACK = encode_packet(message_packet(SpeedControlReply(return_code=0x02), 9, legacy=True))
+
+
+def test_a_legacy_nack_is_the_shortest_packet() -> None:
+    """Return code alone: 17 bytes on the wire, and a packet of its own."""
+    assert len(NACK) == MIN_PACKET_LEN == 17
+    assert PacketFramer().feed(NACK) == [decode_packet(NACK)]
+
+
+def test_a_nack_after_a_truncated_packet_comes_out_at_once() -> None:
+    """A push that lost its tail is dropped as soon as the 17-byte reply after it is complete,
+    without waiting for bytes enough to fill the push's declared length."""
+    framer = PacketFramer()
+    items = framer.feed(PUSH[:20] + NACK)
+    assert items == [Dropped("truncated", PUSH[:20]), decode_packet(NACK)]
+    assert framer.pending == 0

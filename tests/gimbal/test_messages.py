@@ -6,27 +6,37 @@ import dataclasses
 import struct
 
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
+from hypothesis import given, settings, strategies as st
 
 import gimbal.messages as messages_module
+from gimbal.client import FOCUS_CALIBRATIONS, ORIENTATIONS
 from gimbal.crc import crc16, crc32
 from gimbal.errors import PayloadError, RangeError, UnknownMessageError, describe_return_code
-from gimbal.messages import (Kind, Message, Sender, Tlv, all_message_classes, decode_message,
-                             is_legacy_reply, message_packet)
-from gimbal.messages.base import _TYPE_RANGES
+from gimbal.messages import (
+    Kind, Message, Sender, Tlv, all_message_classes, decode_message, is_legacy_reply, message_packet,
+    reply_key,
+)
+from gimbal.messages.base import _TYPE_RANGES, decode_tlvs
 from gimbal.messages.camera import CameraAction, CameraStatusQuery, CameraStatusReply
-from gimbal.messages.external import (DialPush, FocusCalibration, FocusCalibrationReply,
-                                      FocusPositionControl, FocusPositionQuery, JoystickPush)
-from gimbal.messages.motion import (AnglesReply, GetAngles, PositionControl, PositionControlReply,
-                                    SpeedControl, SpeedControlReply, from_raw, to_raw)
-from gimbal.messages.settings import SetAngleLimits, SetMotorStiffness
+from gimbal.messages.external import (
+    DialPush, FocusCalibration, FocusCalibrationReply, FocusPositionControl, FocusPositionQuery,
+    FocusPositionReply, JoystickPush,
+)
+from gimbal.messages.motion import (
+    AnglesReply, GetAngles, PositionControl, PositionControlReply, SpeedControl, SpeedControlReply, from_raw,
+    to_raw,
+)
+from gimbal.messages.settings import (
+    AngleLimitsReply, GetAngleLimits, GetMotorStiffness, MotorStiffnessReply, SetAngleLimits,
+    SetMotorStiffness, SetWorkMode,
+)
 from gimbal.messages.telemetry import ParameterPush, VersionPush, VersionQuery, VersionReply
-from gimbal.messages.tlv_params import (AUTOTUNE, AutoCalibration, CalibrationStatusPush,
-                                        GetUserParams, SetUserParams, UserParamsReply, autotune,
-                                        check_user_param, describe_user_param, motors_off,
-                                        param_table, roll360_mode)
-from gimbal.packet import Packet, decode_packet, encode_packet
+from gimbal.messages.tlv_params import (
+    AUTOTUNE, AutoCalibration, CalibrationStatusPush, GetUserParams, SetUserParams, UserParamsReply, autotune,
+    check_user_param, describe_user_param, motors_off, param_table, roll360_mode,
+)
+from gimbal.packet import Packet, REPLY_CMD_TYPE, decode_packet, encode_packet
+
 
 CLASSES = all_message_classes()
 REPLY_CLASSES = [c for c in CLASSES if c.KIND is Kind.REPLY]
@@ -457,3 +467,186 @@ def test_degrees_to_and_from_the_wires_tenths() -> None:
     for bad in (float("nan"), float("inf"), True, "1"):
         with pytest.raises(RangeError, match="yaw="):
             to_raw(bad, "yaw")  # type: ignore[arg-type]
+
+
+# Payload byte layouts written out from the document's tables (sections 2.3.4 and 2.3.5), with a
+# distinct value in every field: a round trip through our own encoder cannot tell two swapped fields
+# of the same type apart, these can.
+# (message, its payload per the document's table)
+COMMAND_PAYLOADS: list[tuple[Message, bytes]] = [
+    # 2.3.4.4 Figure 10: ctrl_byte, pitch_max, pitch_min, yaw_max, yaw_min, roll_max, roll_min.
+    (SetAngleLimits(ctrl_byte=1, pitch_max=140, pitch_min=50, yaw_max=170, yaw_min=160,
+                    roll_max=25, roll_min=20), bytes((1, 140, 50, 170, 160, 25, 20))),
+    # 2.3.4.6 Figure 12: ctrl_byte, pitch, roll, yaw stiffness.
+    (SetMotorStiffness(ctrl_byte=1, pitch_stiffness=11, roll_stiffness=22, yaw_stiffness=33), bytes((1, 11, 22, 33))),
+    # 2.3.4.10 Figure 17: device id (u32), then version (u32).
+    (VersionPush(device_id=2, version=0x01020304), struct.pack("<II", 2, 0x01020304)),
+    # 2.3.4.11 Figure 21: device_type, pitch_speed, roll_speed, yaw_speed (int16).
+    (JoystickPush(device_type=1, pitch_speed=-300, roll_speed=200, yaw_speed=100), struct.pack("<Bhhh", 1, -300, 200, 100)),
+]
+
+# (the command, its reply, the reply payload per the document's table)
+REPLY_PAYLOADS: list[tuple[type[Message], Message, bytes]] = [
+    # 2.3.4.5 Figure 11: return code, pitch_max, pitch_min, yaw_max, yaw_min, roll_max, roll_min.
+    (GetAngleLimits, AngleLimitsReply(return_code=0, pitch_max=140, pitch_min=50, yaw_max=170, yaw_min=160,
+                                     roll_max=25, roll_min=20), bytes((0, 140, 50, 170, 160, 25, 20))),
+    # 2.3.4.7 Figure 13: return code, pitch, yaw, roll stiffness (not the set command's order).
+    (GetMotorStiffness, MotorStiffnessReply(return_code=0, pitch_stiffness=11, yaw_stiffness=33, roll_stiffness=22),
+     bytes((0, 11, 33, 22))),
+    # 2.3.4.10 Figure 16: return code, device id (u32), version (u32).
+    (VersionQuery, VersionReply(return_code=0, device_id=1, version=0x02030405), struct.pack("<BII", 0, 1, 0x02030405)),
+    # 2.3.4.19 Figure 33: return code, sub-ID 0x02, motor type 0x00, result.
+    (FocusCalibration, FocusCalibrationReply(return_code=0, sub_id=0x02, motor_type=0x00, result=0x01), bytes((0, 0x02, 0x00, 0x01))),
+    # 2.3.4.19 Figure 34: return code, sub-ID 0x15, motor type, calibration state, position (u32).
+    (FocusPositionQuery, FocusPositionReply(return_code=0, sub_id=0x15, motor_type=0x00, calibration_state=0x03,
+                                           position=4000), struct.pack("<BBBBI", 0, 0x15, 0, 3, 4000)),
+    # 2.3.5.2 Figure 36: return code, camera status.
+    (CameraStatusQuery, CameraStatusReply(return_code=0, camera_status=0x02), bytes((0, 0x02))),
+]
+
+
+@pytest.mark.parametrize("message,payload", COMMAND_PAYLOADS, ids=lambda v: getattr(v, "NAME", ""))
+def test_command_payloads_follow_the_documents_tables(message: Message, payload: bytes) -> None:
+    """Encoding puts every field at the document's offset, and decoding reads it back from there."""
+    assert message.encode_payload() == payload
+    packet = Packet.command(message.CMD_SET, message.CMD_ID, payload, seq=1, cmd_type=0x00)
+    assert decode_message(packet).fields() == message.fields()
+
+
+@pytest.mark.parametrize("legacy", [False, True], ids=["latest", "legacy"])
+@pytest.mark.parametrize("request_cls,reply,payload", REPLY_PAYLOADS, ids=lambda v: getattr(v, "NAME", ""))
+def test_reply_payloads_follow_the_documents_tables(request_cls: type[Message], reply: Message,
+                                                    payload: bytes, legacy: bool) -> None:
+    """A reply built byte by byte from the document decodes field by field, in both layouts, and
+    encodes back to the same bytes."""
+    packet = Packet.reply(request_cls.CMD_SET, request_cls.CMD_ID, payload, seq=1, legacy=legacy)
+    assert decode_message(packet, request_cls).fields() == reply.fields()
+    assert message_packet(reply, 1, legacy=legacy).data == packet.data
+
+
+def test_parameter_push_stiffness_is_pitch_yaw_roll_at_bytes_19_to_21() -> None:
+    """Section 2.3.4.9, Figure 15: the push ends with pitch (19), yaw (20), roll (21) stiffness,
+    after the limits in pitch, yaw, roll order (13..18)."""
+    payload = struct.pack("<BhhhhhhBBBBBBBBB", 7, 1, 2, 3, 4, 5, 6, 140, 50, 170, 160, 25, 20, 11, 33, 22)
+    push = decode_message(Packet.command(0x0E, 0x08, payload, seq=1, cmd_type=0x00))
+    assert isinstance(push, ParameterPush)
+    assert (push.pitch_max, push.pitch_min, push.yaw_max, push.yaw_min, push.roll_max, push.roll_min) \
+        == (140, 50, 170, 160, 25, 20)
+    assert (push.pitch_stiffness, push.yaw_stiffness, push.roll_stiffness) == (11, 33, 22)
+
+
+# Which command a latest-layout reply names: CmdSet and CmdID are its first two DATA bytes
+# (section 2.2, Figure 3), however little follows them.
+def test_cmdset_and_cmdid_alone_name_the_command() -> None:
+    """Two DATA bytes are enough to pair the reply; the missing return code fails only decoding."""
+    packet = Packet(REPLY_CMD_TYPE, 1, b"\x0e\x01")
+    assert reply_key(packet) == (0x0E, 0x01)
+    with pytest.raises(PayloadError):
+        decode_message(packet)
+
+
+def test_one_byte_cannot_name_a_command() -> None:
+    with pytest.raises(PayloadError):
+        reply_key(Packet(REPLY_CMD_TYPE, 1, b"\x0e"))
+
+
+# A TLV's LENGTH is one byte (sections 2.3.4.12 and 2.3.4.16: ID + LENGTH + VALUE), so a value of
+# 255 bytes is the longest one that fits.
+def test_a_255_byte_value_fits_and_round_trips() -> None:
+    tlv = Tlv(0x00, bytes(range(255)))
+    encoded = tlv.encode()
+    assert encoded[:2] == b"\x00\xff" and len(encoded) == 257
+    assert decode_tlvs(encoded, "test") == (tlv,)
+
+
+def test_a_256_byte_value_is_refused() -> None:
+    with pytest.raises(RangeError):
+        Tlv(0x00, bytes(256)).encode()
+
+
+# Naming user parameters (section 2.3.4.12, Figure 23): only the document's three 1-byte IDs get a
+# name; any other ID, or a known ID with a value of another length, is shown as raw hex.
+@pytest.mark.parametrize("tlv,described", [
+    (Tlv(0x00, b"\x02"), {"param_table": 2}),
+    (Tlv(0x22, b"\x08"), {"roll360_mode": "two_axis"}),
+    (Tlv(0x23, b"\x01"), {"motors_off": 1}),
+    (Tlv(0x42, b"\x01"), {"0x42": "01"}),
+    (Tlv(0x01, b"\x00"), {"0x01": "00"}),
+    (Tlv(0x23, b"\x01\x00"), {"0x23": "0100"}),
+    (Tlv(0x00, b""), {"0x00": ""}),
+])
+def test_known_ids_are_named_and_the_rest_shown_raw(tlv: Tlv, described: dict[str, int | str]) -> None:
+    assert describe_user_param(tlv) == described
+
+
+# The parameter push's flags byte (section 2.3.4.9, Figure 15): bit 0 angles, bit 1 angle limits,
+# bit 2 stiffness; each bit may be 0 ("the pushed values are invalid"), all three at once included.
+FULL = ParameterPush(7, 100, -20, 300, -1790, 25, -555, 145, 55, 179, 178, 30, 29, 10, 20, 30)
+
+
+@pytest.mark.parametrize("flags,angles,limits,stiffness", [
+    (0x00, False, False, False),
+    (0x01, True, False, False),
+    (0x02, False, True, False),
+    (0x04, False, False, True),
+    (0x07, True, True, True),
+])
+def test_each_flag_bit_validates_its_own_group(flags: int, angles: bool, limits: bool, stiffness: bool) -> None:
+    """A full push is read per group as its flag bit says, and every such flags byte is in range."""
+    push = dataclasses.replace(FULL, ctrl_byte=flags)
+    push.validate()
+    assert (push.angles_valid, push.joint_valid, push.limits_valid, push.stiffness_valid) \
+        == (angles, angles, limits, stiffness)
+
+
+# Set work mode (0x0E/0x0D, section 2.3.4.14, Figure 26): work mode 0xFE (keep) and the seven
+# landscape/portrait codes the document lists, each accepted; anything else refused.
+DOCUMENT_ORIENTATIONS = {
+    0x00: "keep",  # 不切换横竖拍模式
+    0x01: "landscape",  # 绕 X 轴旋转 0° 的横拍
+    0x02: "landscape-flipped",  # 绕 X 轴旋转 180° 的横拍
+    0x03: "portrait",  # 绕 X 轴旋转 90° 的竖拍
+    0x04: "portrait-flipped",  # 绕 X 轴旋转 -90° 的竖拍
+    0x05: "toggle",  # 横拍与竖拍互换
+    0xFF: "default",  # 恢复默认模式
+}
+
+
+@pytest.mark.parametrize("code", sorted(DOCUMENT_ORIENTATIONS))
+def test_every_documented_orientation_encodes(code: int) -> None:
+    """Each code goes out as ``FE code``, and the client's name for it maps to that code."""
+    assert SetWorkMode(orientation=code).encode_payload() == bytes((0xFE, code))
+    assert ORIENTATIONS[DOCUMENT_ORIENTATIONS[code]] == code
+
+
+@pytest.mark.parametrize("field,value", [("orientation", 0x06), ("orientation", 0xFE),
+                                         ("work_mode", 0x00), ("work_mode", 0xFF)])
+def test_values_the_document_does_not_list_are_refused(field: str, value: int) -> None:
+    """Only 0xFE is defined for the work mode; orientations stop at 0x05 and 0xFF."""
+    with pytest.raises(RangeError, match=field):
+        SetWorkMode(**{field: value}).encode_payload()
+
+
+# Focus motor calibration (0x0E/0x12 sub-ID 0x02, section 2.3.4.19, Figure 33): the calibration
+# command codes the document lists, by code and by the client's names; 0x03 is reserved.
+DOCUMENT_COMMANDS = {
+    0x00: "none",  # 无控制
+    0x01: "auto",  # 启动自动校准
+    0x02: "manual",  # 启动手动校准
+    0x04: "set-min",  # 设置校准最小行程点
+    0x05: "set-max",  # 设置校准最大行程点
+    0x06: "stop",  # 停止校准
+}
+
+
+@pytest.mark.parametrize("code", sorted(DOCUMENT_COMMANDS))
+def test_every_documented_calibration_command_encodes(code: int) -> None:
+    """Each code goes out as sub-ID 0x02, motor type 0x00, then the code; its name maps to it."""
+    assert FocusCalibration(calibration_cmd=code).encode_payload() == bytes((0x02, 0x00, code))
+    assert FOCUS_CALIBRATIONS[DOCUMENT_COMMANDS[code]] == code
+
+
+@pytest.mark.parametrize("code", [0x03, 0x07, 0xFF])
+def test_reserved_calibration_commands_are_refused(code: int) -> None:
+    with pytest.raises(RangeError, match="calibration_cmd"):
+        FocusCalibration(calibration_cmd=code).encode_payload()

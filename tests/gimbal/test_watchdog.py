@@ -1,9 +1,17 @@
 """The bus watchdog alone, on a fake clock: states, counts and the snapshot's shape."""
 from __future__ import annotations
 
+import math
+import time
+from dataclasses import dataclass
+
 import pytest
 
-from gimbal.watchdog import DEGRADED, DISENGAGED, ENGAGED, BusWatchdog
+from gimbal.client import GimbalClient
+from gimbal.other_hosts import OtherHostsSeen
+from gimbal.sim import Faults, SimConfig, start_in_process
+from gimbal.watchdog import BusHealth, BusWatchdog, DEGRADED, DISENGAGED, ENGAGED
+from pipelines.loop.link import LinkNotices, link_degraded, link_health, link_report
 
 
 class FakeClock:
@@ -163,3 +171,190 @@ def test_once_closed_the_silence_after_the_last_command_is_not_judged(clock: Fak
     clock.advance(10.0)
     health = dog.snapshot()
     assert (health.state, health.episodes, health.unreachable_s) == (ENGAGED, 0, 0.0)
+
+
+# What a run says about the link: one line per episode, the report line, the exit status's test.
+NOBODY = OtherHostsSeen()
+
+
+def health(state: str = ENGAGED, episodes: int = 0, disengagements: int = 0, unanswered: int = 0,
+           unreachable_s: float = 0.0, late: int = 0) -> BusHealth:
+    return BusHealth(state, 0.0, unanswered, late, unanswered + late, 0, unreachable_s, episodes, disengagements)
+
+
+def test_each_episode_is_said_once_and_the_return_is_said_with_a_restore() -> None:
+    said: list[str] = []
+    notices = LinkNotices(3.0, said.append)
+    assert not notices.update(health(), NOBODY, 1)
+    assert not notices.update(health(DEGRADED, 1, unanswered=3), NOBODY, 2)
+    assert not notices.update(health(DEGRADED, 1, unanswered=9), NOBODY, 3)  # same episode: silent
+    assert not notices.update(health(DISENGAGED, 1, 1, unanswered=80), NOBODY, 90)
+    assert not notices.update(health(DISENGAGED, 1, 1, unanswered=90), NOBODY, 91)
+    assert notices.update(health(DEGRADED, 1, 1, unanswered=95), NOBODY, 150)  # taken back
+    assert not notices.update(health(ENGAGED, 1, 1, unanswered=95), NOBODY, 180)
+    assert not notices.update(health(DEGRADED, 2, 1, unanswered=97), NOBODY, 200)
+    assert [line.split(":")[0] for line in said] == ["frame 2", "frame 90", "frame 150", "frame 200"]
+    assert "3 speed commands without a reply" in said[0]
+    assert "no reply for 3 s: the gimbal is stopped and released" in said[1]
+    assert "taken back" in said[2]
+
+
+def test_another_controller_is_said_once() -> None:
+    said: list[str] = []
+    notices = LinkNotices(3.0, said.append)
+    other = OtherHostsSeen(commands=4, control=4, first_control=1.0, names={"speed_control": 4})
+    notices.update(health(), other, 7)
+    notices.update(health(), OtherHostsSeen(40, 40, 1.0, {"speed_control": 40}), 8)
+    assert said == ["frame 7: another host is driving this gimbal too (4 speed_control): two controllers fight over it"]
+
+
+def test_report_lines_and_exit_status() -> None:
+    clean = link_health(health(), NOBODY)
+    assert link_report(clean, 200) == "gimbal link: clean, 0 of 200 speed commands unanswered"
+    assert not link_degraded(clean)
+    slow = link_health(health(late=190), NOBODY)
+    assert link_report(slow, 200).endswith("0 of 200 speed commands unanswered, 190 answered late")
+    bad = link_health(health(ENGAGED, 1, 1, unanswered=130, unreachable_s=5.06), NOBODY)
+    assert link_report(bad, 400) == ("gimbal link: degraded (1 episode, released 1 time): unreachable 5.1 s, "
+                                     "130 of 400 speed commands unanswered")
+    assert link_degraded(bad)
+    shared = link_health(health(), OtherHostsSeen(3, 2, 1.0, {"speed_control": 2, "get_angles": 1}))
+    assert link_degraded(shared)
+    assert link_report(shared, 10).endswith("; another host sent 2 speed_control, 1 get_angles")
+
+
+class Camera:
+    """What the Recorder uses of a client: record start/stop and the camera's status."""
+
+    def __init__(self) -> None:
+        self.recording = False
+        self.starts = 0
+
+    def start_recording(self) -> None:
+        self.recording, self.starts = True, self.starts + 1
+
+    def stop_recording(self) -> None:
+        self.recording = False
+
+    def camera_status(self) -> bool:
+        return self.recording
+
+
+def test_taking_the_gimbal_back_restarts_a_recording_the_camera_stopped() -> None:
+    from pipelines.loop.recording import Recorder
+
+    camera = Camera()
+    recorder = Recorder(camera, requested=True)  # type: ignore[arg-type]
+    recorder.on_acquired()
+    recorder.restore()  # still recording: nothing sent
+    assert camera.starts == 1 and "restarts" not in recorder.status
+    camera.recording = False  # the gimbal was power-cycled while silent
+    recorder.restore()
+    assert camera.starts == 2 and recorder.status["restarts"] == 1 and recorder.status["start_confirmed"]
+    recorder.stop()
+    recorder.restore()  # stopped on purpose: left stopped
+    assert camera.starts == 2
+
+
+# Issue #26 against the in-process simulated gimbal with faults: the keep-alive streams through
+# lost and corrupted frames, slow replies and silences of 0.3, 2 and 5 s; after the bus timeout the
+# gimbal is stopped and released, then taken back when it answers; the gimbal is still within
+# 0.6 s of every disengagement and of the end.
+STOPPED_WITHIN_S = 0.6
+SAMPLE_S = 0.02
+
+
+@dataclass
+class Run:
+    health: BusHealth
+    stats: dict[str, int]
+    samples: list[tuple[float, float, bool, str]]  # (t, |yaw speed| of the sim, its speed control, watchdog state)
+    ended: float  # when the client began its final stop
+
+
+def run(faults: Faults, duration: float) -> Run:
+    host_bus, sim = start_in_process(SimConfig(), faults)
+    samples: list[tuple[float, float, bool, str]] = []
+    try:
+        with GimbalClient(host_bus) as client:
+            streamer = client.speed_streamer()
+            started = time.monotonic()
+            while (now := time.monotonic()) < started + duration:
+                streamer.set(30.0 * math.sin(2 * math.pi * (now - started) / 4) + 40.0, 0.0)
+                state = sim.state()
+                samples.append((now, abs(state.speeds[0]), state.speed_control, streamer.watchdog.poll()))
+                time.sleep(SAMPLE_S)
+            health, stats = streamer.watchdog.snapshot(), dict(streamer.stats)
+            ended = time.monotonic()
+        while (now := time.monotonic()) < ended + STOPPED_WITHIN_S + 0.2:
+            state = sim.state()
+            samples.append((now, abs(state.speeds[0]), state.speed_control, "closed"))
+            time.sleep(SAMPLE_S)
+    finally:
+        sim.stop()
+        host_bus.shutdown()
+    assert stats["sent"] > 0
+    return Run(health, stats, samples, ended)
+
+
+def assert_stopped_after(result: Run, t: float, until: float = math.inf) -> None:
+    moving = [(round(s - t, 3), speed) for s, speed, _, _ in result.samples
+              if t + STOPPED_WITHIN_S <= s < until and speed > 0.1]
+    assert not moving, f"still moving after {STOPPED_WITHIN_S} s: {moving[:5]}"
+
+
+def disengaged_at(result: Run) -> list[tuple[float, float]]:
+    """(start, end) of each stretch the watchdog said disengaged."""
+    stretches: list[tuple[float, float]] = []
+    began = None
+    for t, _, _, state in result.samples:
+        if state == DISENGAGED and began is None:
+            began = t
+        elif state != DISENGAGED and began is not None:
+            stretches.append((began, t))
+            began = None
+    return stretches
+
+
+@pytest.mark.parametrize("window", [(1.0, 1.3), (1.0, 3.0)], ids=["0.3s", "2s"])
+def test_a_silence_shorter_than_the_timeout_degrades_and_streaming_goes_on(window: tuple[float, float]) -> None:
+    result = run(Faults(silent=window), duration=window[1] + 1.5)
+    gap = window[1] - window[0]
+    assert result.health.episodes >= 1 and result.health.disengagements == 0
+    assert gap - 0.1 <= result.health.unreachable_s <= gap + 0.6
+    assert result.stats["unanswered"] >= gap * 25 * 0.5
+    assert result.stats["disengaged"] == 0
+    resumed = [speed for t, speed, control, _ in result.samples if window[1] + 0.5 < t - result.samples[0][0] and
+               t < result.ended and control]
+    assert resumed and max(resumed) > 5  # the gimbal follows the setpoints again
+    assert_stopped_after(result, result.ended)
+
+
+def test_a_silence_longer_than_the_timeout_disengages_then_reengages() -> None:
+    result = run(Faults(silent=(1.0, 6.0)), duration=7.5)
+    start = result.samples[0][0]
+    assert result.health.disengagements == 1
+    assert (result.stats["disengaged"], result.stats["reengaged"]) == (1, 1)
+    assert 4.8 <= result.health.unreachable_s <= 5.8
+    [(disengaged, reengaged)] = disengaged_at(result)
+    assert 3.8 <= disengaged - start <= 4.6  # 3 s after the last reply
+    assert_stopped_after(result, disengaged, until=reengaged)
+    back = [t for t, speed, control, _ in result.samples if t - start > 6.0 and control and speed > 5]
+    assert back and back[0] - start < 6.8  # taken back within ~0.5 s of the gimbal answering
+    assert_stopped_after(result, result.ended)
+
+
+@pytest.mark.parametrize("faults", [Faults(drop=0.2, seed=3), Faults(corrupt=0.1, seed=3)], ids=["drop", "corrupt"])
+def test_lost_and_corrupted_frames_are_a_degraded_link_not_an_end(faults: Faults) -> None:
+    result = run(faults, duration=3.0)
+    assert result.health.episodes >= 1 and result.stats["unanswered"] > 0
+    assert result.health.unanswered == result.stats["unanswered"]
+    assert result.health.disengagements == 0
+    assert_stopped_after(result, result.ended)
+
+
+def test_slow_replies_are_late_not_missing() -> None:
+    result = run(Faults(delay_s=0.15), duration=3.0)
+    assert result.health.late > 20 and result.health.unanswered == 0
+    assert result.health.disengagements == 0
+    assert_stopped_after(result, result.ended)
