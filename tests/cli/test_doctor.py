@@ -7,6 +7,7 @@ import signal
 import subprocess
 import threading
 import time
+from collections.abc import Callable
 
 import can
 import pytest
@@ -59,6 +60,27 @@ def doctor(config: SimConfig = DEFAULT_CONFIG, faults: Faults = NO_FAULTS, rig: 
 
 def failed(checks: dict[str, Check]) -> set[str]:
     return {name for name, check in checks.items() if not check.ok}
+
+
+def doctor_beside(send: Callable[[can.BusABC], None], every: float) -> dict[str, Check]:
+    """The checks of a doctor run while another node on its bus calls ``send`` every ``every`` seconds."""
+    channel = f"doctor-beside-{time.monotonic_ns()}"
+    other = can.Bus(interface="virtual", channel=channel)
+    stop = threading.Event()
+
+    def keep_sending() -> None:
+        while not stop.wait(every):
+            send(other)
+
+    sender = threading.Thread(target=keep_sending)
+    sender.start()
+    try:
+        checks, _ = doctor(channel=channel)
+    finally:
+        stop.set()
+        sender.join()
+        other.shutdown()
+    return checks
 
 
 def test_every_check_passes_against_the_simulator() -> None:
@@ -159,46 +181,19 @@ def test_error_frames_turn_listen_red() -> None:
     census.on_message_received(can.Message(arbitration_id=0x530, data=b"\x55\x01", is_extended_id=False))
     assert census.counts["error_frames"] == 1 and census.counts["foreign_frames"] == 1
 
-    channel = f"doctor-errors-{time.monotonic_ns()}"
-    noise = can.Bus(interface="virtual", channel=channel)
-    stop = threading.Event()
-
-    def send_errors() -> None:
-        while not stop.wait(0.05):
-            noise.send(can.Message(is_error_frame=True))
-
-    sender = threading.Thread(target=send_errors)
-    sender.start()
-    try:
-        checks, _ = doctor(channel=channel)
-    finally:
-        stop.set()
-        sender.join()
-        noise.shutdown()
+    checks = doctor_beside(lambda noise: noise.send(can.Message(is_error_frame=True)), every=0.05)
     assert not checks["listen"].ok and "bitrate" in checks["listen"].hint
 
 
 def other_host_run(message: Message) -> dict[str, Check]:
     """A doctor run while another host sends ``message`` on 0x223 five times a second."""
-    channel = f"doctor-other-{time.monotonic_ns()}"
-    other = can.Bus(interface="virtual", channel=channel)
-    stop = threading.Event()
     raw = encode_packet(message_packet(message, FIRST_SEQ + 0x100))
 
-    def other_host() -> None:
-        while not stop.wait(0.2):
-            for frame in packet_frames(raw, 0x223):
-                other.send(frame)
+    def other_host(other: can.BusABC) -> None:
+        for frame in packet_frames(raw, 0x223):
+            other.send(frame)
 
-    sender = threading.Thread(target=other_host)
-    sender.start()
-    try:
-        checks, _ = doctor(channel=channel)
-    finally:
-        stop.set()
-        sender.join()
-        other.shutdown()
-    return checks
+    return doctor_beside(other_host, every=0.2)
 
 
 def test_another_controller_on_our_tx_id_is_found() -> None:
