@@ -1,4 +1,5 @@
-"""Standard streams that fail under a run (closed, full, or a reader gone): the results a script parses stay clean and the exit status says what happened."""
+"""Standard streams that fail under a run (closed, full, or a reader gone): the results a script
+parses stay clean and the exit status says what happened."""
 from __future__ import annotations
 
 import io
@@ -13,9 +14,6 @@ import pytest
 import pipelines.cli.decode_cmd
 from pipelines.cli import main
 from tests.support import cli_command, subprocess_env
-
-
-
 
 
 # A closed stderr (``2>&-``): Python gives ``sys.stderr = None``, and ``print(..., file=None)``

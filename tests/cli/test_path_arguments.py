@@ -1,4 +1,5 @@
-"""Path arguments that cannot mean what was typed are refused in one line, before anything is opened or written."""
+"""Path arguments that cannot mean what was typed are refused in one line, before anything is
+opened or written."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -6,9 +7,6 @@ from pathlib import Path
 import pytest
 
 from pipelines.cli import main
-
-
-
 
 
 # An empty path argument is refused in one line (exit 2): ``Path("")`` is the current folder, so

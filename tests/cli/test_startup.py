@@ -1,4 +1,5 @@
-"""The console script's first moments: what it imports, and what a signal or an early error does before the command's handlers are set."""
+"""The console script's first moments: what it imports, and what a signal or an early error does
+before the command's handlers are set."""
 from __future__ import annotations
 
 import argparse
@@ -15,9 +16,6 @@ import pipelines.cli.eval_cmd
 from gimbal.signals import TERMINATING_SIGNALS
 from pipelines.cli import app, main
 from tests.support import subprocess_env
-
-
-
 
 
 # Start-up stays light: ``gimbaltrack --help`` and a ``gimbal ... --print-packet`` load neither

@@ -1,4 +1,5 @@
-"""What GimbalClient's arguments take: each is checked where it is given, by name, and numpy's numbers and bools count as Python's."""
+"""What GimbalClient's arguments take: each is checked where it is given, by name, and numpy's
+numbers and bools count as Python's."""
 from __future__ import annotations
 
 import json
@@ -18,9 +19,6 @@ from gimbal.messages.settings import SetWorkMode
 from gimbal.messages.telemetry import PUSH_DISABLE, PUSH_ENABLE, ParameterPush, PushControl
 from gimbal.sim import start_in_process
 from tests.gimbal.scripted_peer import ScriptedPeer
-
-
-
 
 
 # Timeouts, retry counts and push callbacks are checked where they are given, by name: a

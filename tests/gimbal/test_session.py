@@ -19,9 +19,6 @@ from gimbal.transport import CanTransport, HOST_RX_ID, HOST_TX_ID, packet_frames
 from tests.gimbal.scripted_peer import RELEASE, ScriptedPeer, ZERO, speed_messages
 
 
-
-
-
 # The client's can.Notifier is shared: any python-can listener sees the bus's traffic and ours.
 def _drain(reader: can.BufferedReader) -> list[can.Message]:
     frames = []

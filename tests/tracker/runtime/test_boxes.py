@@ -6,9 +6,6 @@ import pytest
 from tracker.runtime.boxes import Box, clip_to_frame, cut_to_frame, start_box
 
 
-
-
-
 # The subject's first box (``start_box``, used by ``SubjectTracker.init``): kept as given while it
 # overlaps the frame by any amount, refused once it only touches an edge from outside, is not
 # finite or has no width or height, and grown about its centre to 4 px a side when smaller.

@@ -1,4 +1,5 @@
-"""Finding a lost subject again (tracker/runtime/subject.py): the template search, its restart rules and the detector's candidates."""
+"""Finding a lost subject again (tracker/runtime/subject.py): the template search, its restart rules
+and the detector's candidates."""
 from __future__ import annotations
 
 import numpy as np
@@ -13,9 +14,6 @@ from tracker.runtime.appearance import AppearanceModel
 from tracker.runtime.boxes import Box, iou
 from tracker.runtime.estimate import TargetEstimate, TrackState
 from tracker.runtime.subject import SubjectTracker
-
-
-
 
 
 # Re-acquisition by template search: a backend that has left the subject is restarted on the best

@@ -16,9 +16,6 @@ from tracker.runtime import registry
 from tracker.runtime.registry import DEFAULT_BACKEND, EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
 
 
-
-
-
 # NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir. The
 # default stays the correlation filter (docs/tracker.md says why).
 def test_nanotrack3_runs_on_the_embedded_model_files_with_their_licence():

@@ -215,7 +215,8 @@ DEGENERATE: dict[str, Callable[[Box], Answer]] = {
 
 
 def _estimates(odd: Callable[[Box], Answer]) -> list:
-    subject, _ = scripted_tracker(lambda n, restarts: odd(GLITCH_SEQ.boxes[n]) if n in GLITCH else (GLITCH_SEQ.boxes[n], 0.9))
+    subject, _ = scripted_tracker(
+        lambda n, restarts: odd(GLITCH_SEQ.boxes[n]) if n in GLITCH else (GLITCH_SEQ.boxes[n], 0.9))
     subject.init(GLITCH_SEQ.frames[0], GLITCH_SEQ.boxes[0], 0.0)
     return follow(subject, GLITCH_SEQ.frames[1:])
 
