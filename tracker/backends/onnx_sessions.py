@@ -1,7 +1,7 @@
 """Loading ONNX networks into onnxruntime sessions, checked against the shapes a tracker expects.
 
-onnxruntime runs these small networks 1.5-3x faster than ``cv2.dnn`` on one CPU thread and reads
-every operator they use; sessions get one intra-op thread by default, since the tracking loop shares
+onnxruntime runs these small networks faster than ``cv2.dnn`` on one CPU thread and reads every
+operator they use (docs/tracker-lab.md); sessions get one intra-op thread by default, since the tracking loop shares
 the machine with decoding, control and the bus.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ class OnnxNetwork:
         """Load ``path`` and check it by one run on zeros: ``ValueError`` naming the file (as ``what``)
         when it is no ONNX network, or not one taking ``inputs`` and giving ``outputs`` of these shapes;
         ``ImportError`` when onnxruntime is not installed."""
-        import onnxruntime  # optional: make_tracker falls back to dcf without it
+        import onnxruntime  # here, not at the top: only the model trackers need it
 
         if threads < 1:
             raise ValueError(f"threads must be at least 1, not {threads}")
