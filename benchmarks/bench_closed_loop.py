@@ -36,14 +36,14 @@ import numpy as np
 from gimbal.errors import GimbalError
 from gimbal.sim import SimConfig
 from machine import describe_machine
-from pipelines.loop.closed_loop import LoopSettings, run_closed_loop
 from pipelines.control.controller import ControlConfig
 from pipelines.control.direction import DirectionFilter
+from pipelines.loop.closed_loop import LoopSettings, run_closed_loop
 from pipelines.sources.virtual_camera import VirtualCamera
-from tracker.runtime.boxes import center
 from tracker.evaluation.data_paths import shared_sequences
 from tracker.evaluation.datasets import Sequence, load_sequence
 from tracker.evaluation.metrics import has_truth
+from tracker.runtime.boxes import center
 
 LATENCIES_MS = (0, 100)
 CONTROLLERS = ("p", "pid")

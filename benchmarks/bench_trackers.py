@@ -19,11 +19,11 @@ import numpy as np
 
 from machine import describe_machine
 from tracker.backends import TrackingBackend, make_backend
-from tracker.runtime.boxes import Box
+from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
 from tracker.evaluation.data_paths import shared_data_dir, shared_sequences
 from tracker.evaluation.datasets import Sequence, load_sequence
+from tracker.runtime.boxes import Box
 from tracker.runtime.estimate import TargetEstimate, TrackState
-from tracker.evaluation import PERTURBED_STARTS, SequenceResult, perturbed_box, run_sequence, summarize
 from tracker.runtime.registry import EMBEDDED_TRACKER, make_tracker
 
 BASELINE = "opencv-csrt"

@@ -25,23 +25,14 @@ from gimbal.client import GimbalClient, position_message
 from gimbal.errors import GimbalError, GimbalTimeoutError, ReturnCodeError
 from gimbal.framer import Dropped, PacketFramer
 from gimbal.messages import decode_message, is_device_push, reply_key
-from gimbal.messages.external import DialPush, JoystickPush
 from gimbal.messages.firmware import LEGACY_ORDER_DOCUMENT, LEGACY_ORDER_YPR
 from gimbal.messages.limits import ANGLE_RANGES, TENTHS
-from gimbal.messages.motion import (
-    ANGLES_ATTITUDE,
-    AxisDegrees,
-    GetAngles,
-    PositionControl,
-    SpeedControl,
-)
-from gimbal.messages.settings import ActiveTrack, RecenterSelfie
+from gimbal.messages.motion import ANGLES_ATTITUDE, AxisDegrees, GetAngles
 from gimbal.messages.telemetry import ParameterPush
+from gimbal.other_hosts import CONTROL_COMMANDS, UNDECODED
 from gimbal.packet import Packet
 from gimbal.transport import DEFAULT_BITRATE, HOST_RX_ID, HOST_TX_ID
 
-#: Commands that move the gimbal or take it over: another host sending one is another controller.
-CONTROL_COMMANDS = (SpeedControl, PositionControl, RecenterSelfie, JoystickPush, DialPush, ActiveTrack)
 LISTEN_S = 1.0  # the passive census at the start
 LATENCY_QUERIES = 50
 QUERY_TIMEOUT_S = 0.4  # one attitude query's wait; longer than the client's 0.1 s to measure slow replies
@@ -168,7 +159,7 @@ class BusCensus(can.Listener):
         try:
             message = decode_message(packet)
         except GimbalError:
-            self.other_host_commands["undecoded"] += 1
+            self.other_host_commands[UNDECODED] += 1
             return
         self.other_host_commands[message.NAME] += 1
         if isinstance(message, CONTROL_COMMANDS):

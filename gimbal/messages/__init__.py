@@ -8,13 +8,13 @@ from gimbal.messages.base import (CAMERA_CMD_SET, CMD_SETS, DEVICE_PUSHES, GIMBA
                                   all_message_classes)
 from gimbal.messages.camera import *  # noqa: F401,F403  (registers the classes)
 from gimbal.messages.external import *  # noqa: F401,F403
+from gimbal.messages.firmware import (LEGACY_ORDER_DOCUMENT, LEGACY_ORDERS, is_angles_reply_key,
+                                      legacy_angles_payload)
 from gimbal.messages.kinds import Command, DevicePush, HostPush, Reply, ReturnCodeReply
 from gimbal.messages.motion import *  # noqa: F401,F403
 from gimbal.messages.settings import *  # noqa: F401,F403
 from gimbal.messages.telemetry import *  # noqa: F401,F403
 from gimbal.messages.tlv_params import *  # noqa: F401,F403
-from gimbal.messages.firmware import (LEGACY_ORDER_DOCUMENT, LEGACY_ORDERS, is_angles_reply_key,
-                                      legacy_angles_payload)
 from gimbal.packet import NO_REPLY, REPLY_REQUIRED, Packet
 
 

@@ -9,9 +9,10 @@ from typing import ClassVar, NamedTuple
 from gimbal.errors import RangeError
 from gimbal.messages.base import GIMBAL_CMD_SET, register
 from gimbal.messages.kinds import Command, Reply, ReturnCodeReply
+from gimbal.messages.limits import (PITCH_ANGLE_RANGE, ROLL_ANGLE_RANGE, SPEED_RANGE, TENTHS, TIME_RANGE,
+                                    YAW_ANGLE_RANGE)
 from gimbal.values import shown
-from gimbal.messages.limits import (ANGLE_RANGES, PITCH_ANGLE_RANGE, ROLL_ANGLE_RANGE, SPEED_RANGE,
-                                    TENTHS, TIME_RANGE, YAW_ANGLE_RANGE)
+
 DECI_DEGREE = (0.1, "°")
 DECI_DEGREE_PER_S = (0.1, "°/s")
 DECI_SECOND = (0.1, " s")

@@ -9,6 +9,7 @@ from typing import Any
 from gimbal.errors import ReturnCode
 from gimbal.messages import Message, Reply, Tlv
 from gimbal.messages import camera, external, motion, settings, telemetry, tlv_params
+from gimbal.messages.limits import ANGLE_RANGES
 from gimbal.messages.motion import AXES
 from gimbal.messages.tlv_params import CALIBRATION_DONE, CALIBRATION_IDLE, CALIBRATION_RUNNING
 from gimbal.sim.config import SimConfig
@@ -17,7 +18,7 @@ from gimbal.sim.focus import FocusMotor
 from gimbal.sim.state import SimState
 
 MECHANICAL = {axis: (motion.from_raw(low), motion.from_raw(high))
-              for axis, (low, high) in motion.ANGLE_RANGES.items()}  # degrees
+              for axis, (low, high) in ANGLE_RANGES.items()}  # degrees
 ORIENTATIONS = {0x01: 0, 0x02: 180, 0x03: 90, 0x04: -90, 0xFF: 0}
 OK = int(ReturnCode.OK)
 FAILED = int(ReturnCode.EXECUTION_FAILED)

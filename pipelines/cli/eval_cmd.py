@@ -14,8 +14,8 @@ from pipelines.batch import BatchError, InputFailed, Outcome, run_batch
 from pipelines.cli.batch_options import add_batch_options, batch_jobs
 from pipelines.cli.common import CliError, existing_dir, existing_file
 from pipelines.outputs.progress import ProgressReporter
-from tracker.evaluation.datasets import GROUNDTRUTH_NAMES, FrameReadError, Sequence, load_sequence
 from tracker.evaluation import SequenceResult, first_box, run_sequence, summarize
+from tracker.evaluation.datasets import GROUNDTRUTH_NAMES, FrameReadError, Sequence, load_sequence
 from tracker.runtime.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers, make_tracker
 
 

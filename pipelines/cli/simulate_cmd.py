@@ -12,13 +12,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pipelines.loop.closed_loop import ORACLE, LoopResult, LoopSettings, PreparedLoop, prepare_loop, run_prepared
 from pipelines.cli.common import CliError, existing_dir, make_out_dir, out_dir
 from pipelines.control.controller import controller_names
 from pipelines.control.metrics import MAX_ERROR, OVERSHOOT_WINDOW_S
+from pipelines.loop.closed_loop import ORACLE, LoopResult, LoopSettings, PreparedLoop, prepare_loop, run_prepared
 from pipelines.outputs.latency import latency_percentiles
-from pipelines.outputs.summary import write_summary
 from pipelines.outputs.progress import ProgressReporter
+from pipelines.outputs.summary import write_summary
 from tracker.runtime.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, available_trackers
 
 if TYPE_CHECKING:

@@ -14,22 +14,22 @@ from typing import Any
 from gimbal.client import GimbalClient
 from gimbal.errors import GimbalError, GimbalTimeoutError
 from gimbal.keepalive import MAX_RATE_HZ, MIN_RATE_HZ
-from gimbal.watchdog import DEFAULT_TIMEOUT_S, DEGRADED_SILENCE_S
 from gimbal.signals import SignalExit, deferred_signals
 from gimbal.values import shown
-from pipelines.loop.acquire import PICKS, check_roi_in_frame, parse_roi
+from gimbal.watchdog import DEFAULT_TIMEOUT_S, DEGRADED_SILENCE_S
 from pipelines.cli.batch_options import add_batch_options, batch_jobs
 from pipelines.cli.bus import SIM_INTERFACE, choose_track_bus, open_host_bus
+from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.cli.firmware_opts import add_legacy_order_option
 from pipelines.cli.sim_faults import parse_sim_faults
-from pipelines.loop.link import link_degraded, link_report
-from pipelines.cli.common import EXIT_INTERRUPTED, CliError, add_bus_options, existing_dir, make_out_dir, out_dir
 from pipelines.cli.track_batch import run_track_batch
-from pipelines.control import ControlConfig, controller_names
+from pipelines.control.controller import ControlConfig, controller_names
 from pipelines.control.limits import PROTOCOL_MAX_SPEED_DPS
+from pipelines.loop.acquire import PICKS, check_roi_in_frame, parse_roi
+from pipelines.loop.link import link_degraded, link_report
+from pipelines.loop.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
 from pipelines.outputs.can_log import CanLogWriter
 from pipelines.sources import FrameSource, SourceError, open_source
-from pipelines.loop.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, TrackOptions, TrackSession, make_subject
 from tracker import SubjectTracker, available_trackers
 from tracker.detectors import Detector
 

@@ -16,7 +16,7 @@ from pipelines.outputs.latency import latency_percentiles
 
 if TYPE_CHECKING:
     from gimbal.client import GimbalClient
-    from pipelines.control import CameraModel
+    from pipelines.control.camera import CameraModel
     from pipelines.loop import FrameRecord, Loop
 
 CONSOLE_STOP = "stopped from the console"

@@ -30,12 +30,12 @@ from pipelines.loop import Loop, Sink
 from pipelines.sources import Frame
 from pipelines.sources.virtual_camera import VirtualCamera
 from tracker import SubjectTracker, make_tracker
-from tracker.runtime.boxes import Box, center, start_box
-from tracker.evaluation.datasets import Sequence, load_sequence
 from tracker.detectors import Detection
-from tracker.runtime.estimate import TargetEstimate, TrackState
 from tracker.evaluation import first_box
+from tracker.evaluation.datasets import Sequence, load_sequence
 from tracker.evaluation.metrics import has_truth
+from tracker.runtime.boxes import Box, center, start_box
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 if TYPE_CHECKING:
     import can

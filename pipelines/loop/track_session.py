@@ -16,13 +16,14 @@ from typing import TYPE_CHECKING, Any
 from gimbal.errors import GimbalError
 from gimbal.signals import deferred_signals
 from gimbal.watchdog import DEFAULT_TIMEOUT_S
-from pipelines.loop.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartConfirmer
-from pipelines.control import CameraModel, ControlConfig, make_controller
+from pipelines.control.camera import CameraModel
+from pipelines.control.controller import ControlConfig, make_controller
 from pipelines.control.gimbal_link import GimbalLink, Signs
 from pipelines.control.tuning import settings_of
 from pipelines.loop import (
     Loop, PlotSink, ProgressSink, Recorder, SummarySink, TelemetrySink, VideoSink, loop_panels,
 )
+from pipelines.loop.acquire import CAMERA_MOTION_FRACTION, AcquiringSubject, StartConfirmer
 from pipelines.loop.link import LinkNotices, LinkSink, link_health
 from pipelines.loop.record import FrameRecord
 from pipelines.outputs.latency import latency_percentiles

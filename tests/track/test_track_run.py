@@ -14,7 +14,7 @@ import pytest
 from gimbal.messages.camera import CameraActionCode
 from pipelines.cli import track_cmd
 from pipelines.cli.app import build_parser
-from pipelines.control import ControlConfig
+from pipelines.control.controller import ControlConfig
 from pipelines.control.gimbal_link import Signs
 from pipelines.outputs.telemetry import read_telemetry
 from pipelines.loop.track_session import TrackOptions

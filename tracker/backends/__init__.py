@@ -9,14 +9,14 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from tracker.runtime.boxes import Box, cut_to_frame
 from tracker.backends.dcf import DcfBackend
-from tracker.runtime.frames import as_bgr, as_bgr_or_grey
 from tracker.backends.fear import FearBackend
 from tracker.backends.nanotrack import (V3_PARAMS, NanoTrackBackend, OrtNanoNetworks, load_nanotrack_networks,
                                nanotrack_model_files)
 from tracker.backends.onnx_sessions import DEFAULT_THREADS
 from tracker.backends.vittrack import VitTrackBackend
+from tracker.runtime.boxes import Box, cut_to_frame
+from tracker.runtime.frames import as_bgr, as_bgr_or_grey
 
 
 class TrackingBackend(Protocol):

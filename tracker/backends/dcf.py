@@ -16,12 +16,12 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tracker.runtime.boxes import Box, center, from_center
 from tracker.backends.colour_model import ColourModel, box_response, colour_index
 from tracker.backends.correlation import TranslationFilter
-from tracker.runtime.crops import resample_window
 from tracker.backends.features import CELL, cell_features, unit_grey
 from tracker.backends.scale_estimator import ScaleEstimator
+from tracker.runtime.boxes import Box, center, from_center
+from tracker.runtime.crops import resample_window
 
 
 @dataclass(frozen=True)

@@ -22,10 +22,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tracker.runtime.boxes import Box, from_center
-from tracker.runtime.crops import resample_window
 from tracker.backends.model_files import find_model_file
 from tracker.backends.onnx_sessions import DEFAULT_THREADS, OnnxNetwork
+from tracker.runtime.boxes import Box, from_center
+from tracker.runtime.crops import resample_window
 
 EXEMPLAR_SIZE = 127  # template crop side, pixels
 INSTANCE_SIZE = 255  # search crop side, pixels
@@ -71,13 +71,15 @@ V3_PARAMS = NanoTrackParams(window_influence=0.455, penalty_k=0.138, size_lr=0.3
                             calibration_strength=0.0)
 
 
-def nanotrack_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
-    """The backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v2/``)."""
+def nanotrack_model_files(model_dir: str | Path | None, version: str = "v2") -> tuple[Path, Path]:
+    """NanoTrack's backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v2/`` or
+    ``nanotrack_v3/``): the two versions' files have the same names, so the folder tells them apart."""
+    what = "NanoTrack" if version == "v2" else f"NanoTrack {version}"
     if model_dir is None:
-        raise FileNotFoundError("NanoTrack needs its model files: pass a model directory (--model-dir, or "
+        raise FileNotFoundError(f"{what} needs its model files: pass a model directory (--model-dir, or "
                                 "model_dir= in Python) holding nanotrack_backbone*.onnx and nanotrack_head*.onnx")
-    backbone = find_model_file(model_dir, "nanotrack_v2", "nanotrack_backbone*.onnx", "NanoTrack")
-    head = find_model_file(model_dir, "nanotrack_v2", "nanotrack_head*.onnx", "NanoTrack")
+    backbone = find_model_file(model_dir, f"nanotrack_{version}", "nanotrack_backbone*.onnx", what)
+    head = find_model_file(model_dir, f"nanotrack_{version}", "nanotrack_head*.onnx", what)
     return backbone, head
 
 
@@ -136,16 +138,6 @@ def _check_head(net: cv2.dnn.Net, path: Path, template: np.ndarray, search: np.n
                          "backbone's template and search features; is it a second backbone?)")
 
 
-def nanotrack_v3_model_files(model_dir: str | Path | None) -> tuple[Path, Path]:
-    """NanoTrack v3's backbone and neck/head ONNX files in ``model_dir`` (or its ``nanotrack_v3/``)."""
-    if model_dir is None:
-        raise FileNotFoundError("NanoTrack v3 needs its model files: pass a model directory holding "
-                                "nanotrack_v3/nanotrack_backbone*.onnx and nanotrack_head*.onnx")
-    backbone = find_model_file(model_dir, "nanotrack_v3", "nanotrack_backbone*.onnx", "NanoTrack v3")
-    head = find_model_file(model_dir, "nanotrack_v3", "nanotrack_head*.onnx", "NanoTrack v3")
-    return backbone, head
-
-
 class CvNanoNetworks:
     """NanoTrack v2's two networks on ``cv2.dnn``: backbone features, then the head's maps."""
 
@@ -177,7 +169,7 @@ class OrtNanoNetworks:
     score_size = V3_SCORE_SIZE
 
     def __init__(self, model_dir: str | Path | None, threads: int = DEFAULT_THREADS, channels: int = 96) -> None:
-        backbone, head = nanotrack_v3_model_files(model_dir)
+        backbone, head = nanotrack_model_files(model_dir, "v3")
         self._backbone = OnnxNetwork(backbone, "NanoTrack v3 backbone", {"input": (1, 3, INSTANCE_SIZE, INSTANCE_SIZE)},
                                      {"output": (1, channels, SEARCH_FEATURES, SEARCH_FEATURES)}, threads)
         maps = (V3_SCORE_SIZE, V3_SCORE_SIZE)

@@ -19,10 +19,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tracker.runtime.boxes import Box, from_center
 from tracker.backends.model_files import find_model_file
 from tracker.backends.nanotrack import crop_square
 from tracker.backends.onnx_sessions import DEFAULT_THREADS, OnnxNetwork
+from tracker.runtime.boxes import Box, from_center
 from tracker.runtime.typical import RunningTypical
 
 TEMPLATE_SIZE = 128  # template crop side, pixels

@@ -14,10 +14,10 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from tracker.backends.model_files import checked_model_dir, find_model_file
 from tracker.detectors import camera_motion
 from tracker.runtime.boxes import Box
 from tracker.runtime.frames import as_bgr, as_bgr_or_grey, as_grey, check_frame
-from tracker.backends.model_files import checked_model_dir, find_model_file
 
 DETECTOR_KINDS = ("face", "person", "motion")
 HAAR_FACE = "haarcascade_frontalface_default.xml"

@@ -9,10 +9,10 @@ from typing import Protocol
 
 import numpy as np
 
-from tracker.runtime.boxes import Box, center, from_center
 from tracker.evaluation.datasets import ASSUMED_FPS, Sequence
-from tracker.runtime.estimate import TargetEstimate, TrackState
 from tracker.evaluation.metrics import has_truth, precision_at, success_auc
+from tracker.runtime.boxes import Box, center, from_center
+from tracker.runtime.estimate import TargetEstimate, TrackState
 
 
 class Trackable(Protocol):

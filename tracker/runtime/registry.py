@@ -4,10 +4,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from tracker.backends import BACKEND_NAMES, MODEL_BACKENDS, make_backend
-from tracker.detectors import Detector
 from tracker.backends.model_files import checked_model_dir
 from tracker.backends.nanotrack import nanotrack_model_files
 from tracker.backends.onnx_sessions import DEFAULT_THREADS
+from tracker.detectors import Detector
 from tracker.runtime.subject import SubjectTracker, TrackerSettings
 
 #: The default: the correlation filter. NanoTrack v3 scores higher on the 19 shared sequences

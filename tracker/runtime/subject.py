@@ -7,12 +7,12 @@ from numbers import Real
 
 import numpy as np
 
-from tracker.runtime.appearance import AppearanceModel, Match, cut_patch
 from tracker.backends import TrackingBackend
-from tracker.runtime.boxes import Box, start_box
-from tracker.runtime.frames import as_bgr_or_grey
 from tracker.detectors import Detector
+from tracker.runtime.appearance import AppearanceModel, Match, cut_patch
+from tracker.runtime.boxes import Box, start_box
 from tracker.runtime.estimate import TargetEstimate, TrackState
+from tracker.runtime.frames import as_bgr_or_grey
 from tracker.runtime.kalman import BoxKalman
 
 
