@@ -1,8 +1,8 @@
 """One line naming the machine a benchmark ran on, printed beside its figures.
 
-Figures move with the CPU: on an AMD EPYC without AVX-512, ``cv2.dnn`` ran NanoTrack at 68 fps
-where an earlier machine of the same kind gave 103 (docs/tracker.md), so every table says where
-it was measured.
+Figures move with the CPU: ``cv2.dnn`` ran NanoTrack markedly slower on an AMD EPYC without
+AVX-512 than on an earlier machine of the same kind (docs/tracker-lab.md), so every table says
+where it was measured.
 """
 from __future__ import annotations
 

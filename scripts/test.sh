@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Set up on first use (venv, test extras, FFmpeg for the live-stream test, Chromium and its driver
-# for the console's browser test), then run the test suite. Extra arguments go to pytest.
+# for the console's browser test), then run the test suite on every core. Extra arguments go to pytest.
 source "$(dirname "$0")/_venv.sh" test
 missing=()
 command -v ffmpeg >/dev/null 2>&1 || missing+=(ffmpeg)
@@ -16,4 +16,4 @@ if [ "${#missing[@]}" -gt 0 ]; then
     fi
 fi
 cd "$ROOT"
-exec "$VENV/bin/python" -m pytest "$@"
+exec "$VENV/bin/python" -m pytest -n auto "$@"  # one worker per core; `-n 0` after it wins

@@ -21,8 +21,8 @@ _FONT = cv2.FONT_HERSHEY_SIMPLEX
 
 def shrunk(image: np.ndarray, max_width: int) -> tuple[np.ndarray, float]:
     """A copy at most ``max_width`` wide, and its pixels per source pixel. Bilinear: a live view
-    can afford its slight aliasing, not INTER_AREA's cost at uneven ratios (1280 -> 960 px: about
-    20 times as long, more than the JPEG encoding itself)."""
+    can afford its slight aliasing, not INTER_AREA's cost at uneven ratios (more than the JPEG
+    encoding itself, docs/console.md)."""
     height, width = image.shape[:2]
     if width <= max_width:
         return image.copy(), 1.0

@@ -39,8 +39,8 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 SUMMARY_EVERY_S = 1.0
-#: The annotated video's default width: enough to review the run, and cheap to encode (a 720p
-#: frame at full size costs 3.6-5 ms of CPU, a 4K one several times that).
+#: The annotated video's default width: enough to review the run, and cheap to encode (a frame at
+#: full 720p or 4K size costs several times as much, docs/outputs.md).
 DEFAULT_VIDEO_WIDTH = 640
 FEEDBACK_MODES = ("auto", "on", "off")
 

@@ -137,8 +137,8 @@ class VideoFileSource(FileSource):
                  sleep: Callable[[float], None] = time.sleep) -> None:
         if not path.is_file():
             raise SourceError(f"video file not found: {path}")
-        # One decoder thread: the tracking loop needs the other core more than FFmpeg's frame
-        # threading does (bench_pipeline: 260 vs 228 fps on 720p H.264, 2 cores).
+        # One decoder thread: on 2 cores the tracking loop needs the other core more than FFmpeg's
+        # frame threading does (the loop ran faster so, docs/track.md).
         capture = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, 1])
         if not capture.isOpened():
             raise SourceError(f"cannot open {path}: not a video OpenCV can read")

@@ -94,10 +94,10 @@ def _csrt(**overrides: float | bool) -> Callable[[], cv2.Tracker]:
     return create
 
 
-# CSRT without colour segmentation: 1.1-1.3x the speed of OpenCV's defaults at equal accuracy
-# (docs/tracker.md). A 100 px template was faster still, but its scale estimate is fragile: on an
-# AMD EPYC it followed neither a 0.7x nor a 1.6x zoom (tests/tracker/runtime/test_subject_tracker.py, scale
-# change); fewer scale samples broke that test too.
+# CSRT without colour segmentation: somewhat faster than OpenCV's defaults and as accurate
+# (docs/tracker-lab.md). A smaller template was faster still, but its scale estimate stopped
+# following a zoom on some CPUs (tests/tracker/runtime/test_subject_tracker.py, scale change); fewer scale
+# samples broke that test too.
 FAST_CSRT = {"use_segmentation": False}
 
 

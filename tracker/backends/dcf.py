@@ -36,7 +36,7 @@ class DcfSettings:
     colour_weight: float = 0.3  # share of the colour response in the blend
     inner_padding: float = 0.2  # foreground = subject shrunk by this x mean side
     # fDSST's finer ladder (Danelljan et al., 2017): 33 samples 1.02 apart reach as far as 17 at 1.03
-    # and took the 19 shared sequences' mean AUC from 0.565 to 0.575 (docs/tracker.md)
+    # in finer steps, which scored higher over all 19 shared sequences (docs/tracker-lab.md)
     scales: int = 33
     scale_step: float = 1.02
     scale_area: float = 512.0  # scale samples are resized to about this many pixels (DSST's value)
@@ -45,9 +45,9 @@ class DcfSettings:
     max_scale: float = 5.0
     peak_rate: float = 0.05  # how fast the typical response peak follows confident frames
     learn_above: float = 0.4  # frames scoring lower (occluded, probably) teach the models nothing
-    # Scale and learning every this many frames, at that many times the rates: the tracker ~40 %
-    # faster, its accuracy within the noise of learning every frame; 3 gained little more speed in
-    # the loop, 5 lost accuracy (docs/tracker.md).
+    # Scale and learning every this many frames, at that many times the rates: a clearly faster
+    # tracker whose accuracy stays within the noise of learning every frame; 3 gained little more
+    # speed in the loop, 5 lost accuracy (docs/tracker-lab.md).
     update_every: int = 2
 
     def __post_init__(self) -> None:
@@ -121,7 +121,7 @@ class DcfBackend:
         The typical value is the mean of the first 1 / ``peak_rate`` such peaks, then a running
         value: the first frame's peak alone, from a filter that has seen only the start frame, was
         up to four times what followed on drone and broadcast footage, so every later frame scored
-        under ``learn_above`` and the models never learnt again (docs/tracker.md)."""
+        under ``learn_above`` and the models never learnt again (docs/tracker-lab.md)."""
         s = self.settings
         if self._typical_frames == 0:
             self._typical_peak = peak
@@ -168,7 +168,7 @@ class DcfBackend:
 
     def _window_patch(self, region: _Region) -> np.ndarray:
         """The window resampled to the patch size in one bilinear warp, at under 4:1 (see ``_Region``):
-        a crop then an area resize cost five times as much and scored the same (docs/tracker.md), and
+        a crop then an area resize cost several times as much and scored the same (docs/tracker-lab.md), and
         averaging the region down further to keep bilinear under 2:1 scored lower on perturbed starts."""
         window = self._base_window * self._scale / region.k
         return resample_window(region.image, region.to_region(self._center), window, self._patch_size)

@@ -34,7 +34,7 @@ TEMPLATE_GROWTH = 0.2  # the template crop adds this much of the box's width / h
 SEARCH_GROWTH = 2.0  # the search crop adds this much on each side
 MIN_SIZE = 3.0  # smallest box side kept, pixels (the reference's)
 # The subject's typical template-feature likeness is measured on its confident frames (probability
-# at least LIKENESS_SCORE), one in LIKENESS_EVERY: a template pass costs about a third of a search.
+# at least LIKENESS_SCORE), one in LIKENESS_EVERY: a template pass is a sizeable share of a search.
 LIKENESS_SCORE = 0.5
 LIKENESS_EVERY = 10
 

@@ -58,7 +58,7 @@ class NanoTrackParams:
     # follows frames at likeness_learn_above of it or more at likeness_rate (as dcf's response peak),
     # so it does not sink to the background's level. The factor ramps from 0 at likeness_zero of the
     # typical value (background boxes there sat just over the confidence gate) to 1 at likeness_full
-    # of it or more (the subject's own frame-to-frame scatter; at 1.0 it cost AUC, docs/tracker.md).
+    # of it or more (the subject's own frame-to-frame scatter; at 1.0 it cost AUC, docs/tracker-lab.md).
     likeness_rate: float = 0.05
     likeness_learn_above: float = 0.6
     likeness_full: float = 0.75

@@ -1,7 +1,7 @@
 """Loading ONNX networks into onnxruntime sessions, checked against the shapes a tracker expects.
 
-onnxruntime runs these small networks 1.5-3x faster than ``cv2.dnn`` on one CPU thread and reads
-every operator they use; sessions get one intra-op thread by default, since the tracking loop shares
+onnxruntime runs these small networks faster than ``cv2.dnn`` on one CPU thread and reads every
+operator they use (docs/tracker-lab.md); sessions get one intra-op thread by default, since the tracking loop shares
 the machine with decoding, control and the bus.
 """
 from __future__ import annotations
@@ -16,6 +16,10 @@ DEFAULT_THREADS = 1  # intra-op threads per session
 Shape = tuple[int, ...]
 
 
+class RuntimeMissingError(ValueError):
+    """A model tracker asked for where its runtime is not installed."""
+
+
 class OnnxNetwork:
     """One network on onnxruntime: ``run(**inputs)`` gives its outputs by name, as float32 arrays."""
 
@@ -23,8 +27,13 @@ class OnnxNetwork:
                  threads: int = DEFAULT_THREADS) -> None:
         """Load ``path`` and check it by one run on zeros: ``ValueError`` naming the file (as ``what``)
         when it is no ONNX network, or not one taking ``inputs`` and giving ``outputs`` of these shapes;
-        ``ImportError`` when onnxruntime is not installed."""
-        import onnxruntime  # optional: make_tracker falls back to dcf without it
+        ``RuntimeMissingError`` (a ``ValueError``: the tracker asked for cannot run here, which the
+        CLI reports in one line) when onnxruntime is not installed."""
+        try:
+            import onnxruntime  # here, not at the top: only the model trackers need it
+        except ImportError as exc:
+            raise RuntimeMissingError(f"{what} runs on onnxruntime, which is not installed here "
+                                      "(pip install onnxruntime), or choose --tracker dcf") from exc
 
         if threads < 1:
             raise ValueError(f"threads must be at least 1, not {threads}")

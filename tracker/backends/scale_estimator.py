@@ -1,7 +1,7 @@
 """DSST-style scale estimation: the subject's box at a ladder of scale factors, sampled to a fixed
 size, described by cell features and matched by a 1-D correlation filter over the ladder.
 
-Used by ``dcf`` for its scale (beside NanoTrack it did not help: docs/tracker.md). The method is
+Used by ``dcf`` for its scale (beside NanoTrack it did not help: docs/tracker-lab.md). The method is
 that of DSST (Danelljan et al., 2014); the implementation is our own.
 """
 from __future__ import annotations
