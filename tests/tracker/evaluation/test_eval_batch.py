@@ -8,15 +8,13 @@ import subprocess
 import time
 from pathlib import Path
 
-import cv2
 import pytest
 
 from pipelines.cli.eval_cmd import score_all
 from tests import fake_onnx
 from tests.support import cli_command, signalled
-from tests.tracker.evaluation.batch_helpers import scores, write_otb
+from tests.tracker.evaluation.batch_helpers import long_sequence, scores, write_otb
 from tracker.evaluation.datasets import load_sequence
-from tracker.evaluation.synthetic import render_sequence
 
 
 def gimbaltrack(*argv: str) -> subprocess.CompletedProcess:
@@ -91,19 +89,6 @@ def test_the_summary_names_the_tracker_and_its_model(folders, tmp_path):
                        "--jobs", "2")
     summary = json.loads(nano.stdout.splitlines()[-1])
     assert summary["tracker"] == "nanotrack" and summary["model"] == str(models)
-
-
-def long_sequence(folder: Path, count: int = 3000) -> Path:
-    """The same two images ``count`` times over: a run of many seconds."""
-    frames = render_sequence(frames=2, seed=3)
-    (folder / "img").mkdir(parents=True)
-    for i in range(1, 3):
-        cv2.imwrite(str(folder / f"{i}.png"), frames.frames[i - 1])
-    for i in range(1, count + 1):
-        (folder / "img" / f"{i:05d}.png").symlink_to(folder / f"{i % 2 + 1}.png")
-    box = ",".join(f"{v:.1f}" for v in frames.boxes[0])
-    (folder / "groundtruth_rect.txt").write_text(f"{box}\n" * count)
-    return folder
 
 
 def finished_one(process: subprocess.Popen) -> bool:

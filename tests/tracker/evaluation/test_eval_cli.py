@@ -9,6 +9,7 @@ import pytest
 
 from tests import fake_onnx
 from tests.support import cli_command, signalled, write_clip
+from tests.tracker.evaluation.batch_helpers import long_sequence
 from tracker.evaluation.synthetic import render_sequence
 
 
@@ -183,16 +184,8 @@ def test_help_states_defaults_and_examples():
 
 
 def test_sigterm_exits_143_with_a_note(tmp_path):
-    frames = render_sequence(frames=2, seed=3)
-    (tmp_path / "img").mkdir()
-    count = 3000  # the same two images over and over: a run of several seconds
-    for i in range(1, 3):
-        cv2.imwrite(str(tmp_path / f"{i}.png"), frames.frames[i - 1])
-    for i in range(1, count + 1):
-        (tmp_path / "img" / f"{i:05d}.png").symlink_to(tmp_path / f"{i % 2 + 1}.png")
-    box = ",".join(f"{v:.1f}" for v in frames.boxes[0])
-    (tmp_path / "groundtruth_rect.txt").write_text(f"{box}\n" * count)
-    code, stdout, stderr = signalled(cli_command("eval", str(tmp_path), "--tracker", "csrt"),
+    sequence = long_sequence(tmp_path / "long")
+    code, stdout, stderr = signalled(cli_command("eval", str(sequence), "--tracker", "csrt"),
                                      lambda process: process.stderr.readline().startswith("["))  # progress
     assert code == 143 and stdout == ""
     assert stderr.splitlines()[-1] == "gimbaltrack eval: terminated (SIGTERM)" and "Traceback" not in stderr
