@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from tracker.runtime.boxes import Box, center, iou
@@ -177,6 +177,11 @@ class AcquiringSubject:
         self.candidates: tuple[Detection, ...] = ()
         self._start: Box | None = roi
         self._estimate: TargetEstimate | None = None
+        #: The frame's time in its video, set by the driver before each step when frames are stamped
+        #: as they are read (a file at file speed): the tracker's motion model then runs on the
+        #: video's time, not on how fast this machine reads it, so a run gives the same boxes every
+        #: time (and ``eval``'s). Its estimates still carry the loop's time, which control uses.
+        self.video_t: float | None = None
 
     @property
     def name(self) -> str:
@@ -192,11 +197,14 @@ class AcquiringSubject:
             self._start = self._detect(image)
             if self._start is None:
                 return None
+        tracker_t = t if self.video_t is None else self.video_t
         if self._start is not None:
             box, self._start = self._start, None
-            self._estimate = self.tracker.init(image, box, t)
+            self._estimate = self.tracker.init(image, box, tracker_t)
         else:
-            self._estimate = self.tracker.update(image, t)
+            self._estimate = self.tracker.update(image, tracker_t)
+        if self.video_t is not None:
+            self._estimate = replace(self._estimate, timestamp=t)
         return self._estimate
 
     def _detect(self, image: np.ndarray) -> Box | None:

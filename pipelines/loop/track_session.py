@@ -190,8 +190,10 @@ class TrackSession:
 
     def step(self, frame: Frame) -> FrameRecord:
         """One frame through the loop, its outputs written."""
-        stamp = frame.timestamp if self._monotonic_stamps else self.loop.clock()
-        return self.loop.step(frame, stamp)
+        if self._monotonic_stamps:
+            return self.loop.step(frame, frame.timestamp)
+        self.subject.video_t = frame.timestamp
+        return self.loop.step(frame, self.loop.clock())
 
     # -- the end -------------------------------------------------------------------------
     def finish(self, reason: str | None = None, error: str | None = None) -> dict[str, Any]:
