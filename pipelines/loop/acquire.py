@@ -11,6 +11,7 @@ from tracker.runtime.boxes import Box, center, iou
 if TYPE_CHECKING:  # the tracker and detectors load OpenCV and SciPy: only a run needs them
     import numpy as np
 
+    from pipelines.sources.base import Frame
     from tracker.detectors import Detection, Detector
     from tracker.runtime.estimate import TargetEstimate
     from tracker.runtime.subject import SubjectTracker
@@ -165,23 +166,25 @@ class AcquiringSubject:
     on every frame while none is chosen: the motion detector needs consecutive frames), then the
     tracker. A lost subject is found again by the tracker, which runs ``detector`` itself: a
     detection that looks like it, never merely the nearest one, so the subject's look is kept and
-    another person's is not taken for it."""
+    another person's is not taken for it.
+
+    With ``video_time`` (a file read faster than it was filmed, its frames stamped as they are read)
+    the tracker's motion model runs on each frame's time in the video, not on how fast this machine
+    reads it, so a run gives the same boxes every time; the estimates still carry the loop's time,
+    which control uses."""
 
     def __init__(self, tracker: SubjectTracker, detector: Detector | None, frame_size: tuple[int, int], *,
-                 roi: Box | None = None, pick: str = "central", confirmer: StartConfirmer | None = None) -> None:
+                 roi: Box | None = None, pick: str = "central", confirmer: StartConfirmer | None = None,
+                 video_time: bool = False) -> None:
         self.tracker = tracker
         self.detector = detector
         self.frame_size = frame_size
         self.pick = pick
         self.confirmer = confirmer or StartConfirmer()
         self.candidates: tuple[Detection, ...] = ()
+        self.video_time = video_time
         self._start: Box | None = roi
         self._estimate: TargetEstimate | None = None
-        #: The frame's time in its video, set by the driver before each step when frames are stamped
-        #: as they are read (a file at file speed): the tracker's motion model then runs on the
-        #: video's time, not on how fast this machine reads it, so a run gives the same boxes every
-        #: time (and ``eval``'s). Its estimates still carry the loop's time, which control uses.
-        self.video_t: float | None = None
 
     @property
     def name(self) -> str:
@@ -191,19 +194,19 @@ class AcquiringSubject:
         """Start the tracker afresh on ``box`` at the next frame."""
         self._start = tuple(box)
 
-    def estimate(self, image: np.ndarray, t: float) -> TargetEstimate | None:
+    def estimate(self, frame: Frame, t: float) -> TargetEstimate | None:
         self.candidates = ()
         if self._start is None and self._estimate is None:
-            self._start = self._detect(image)
+            self._start = self._detect(frame.image)
             if self._start is None:
                 return None
-        tracker_t = t if self.video_t is None else self.video_t
+        tracker_t = frame.timestamp if self.video_time else t
         if self._start is not None:
             box, self._start = self._start, None
-            self._estimate = self.tracker.init(image, box, tracker_t)
+            self._estimate = self.tracker.init(frame.image, box, tracker_t)
         else:
-            self._estimate = self.tracker.update(image, tracker_t)
-        if self.video_t is not None:
+            self._estimate = self.tracker.update(frame.image, tracker_t)
+        if self.video_time:
             self._estimate = replace(self._estimate, timestamp=t)
         return self._estimate
 

@@ -93,7 +93,7 @@ class OracleTracker:
 class SimulatedSubject:
     """What the loop follows in a simulation (a ``pipelines.loop.Subject``): the oracle's estimate
     of the frame's ground truth, or a real tracker, started on the first view's ground truth (that
-    first frame's estimate is the oracle's). The driver sets ``truth`` and ``index`` before each step."""
+    first frame's estimate is the oracle's). The driver sets ``truth`` before each step."""
 
     candidates: tuple[Detection, ...] = ()
 
@@ -101,7 +101,6 @@ class SimulatedSubject:
         self.oracle = oracle
         self.tracker = tracker
         self.truth: Box | None = None
-        self.index = 0
         self._start: Box | None = None
 
     @property
@@ -114,17 +113,17 @@ class SimulatedSubject:
             raise ValueError("the oracle follows the ground truth: it takes no start box")
         self._start = tuple(box)
 
-    def estimate(self, image: np.ndarray, t: float) -> TargetEstimate:
-        oracle = self.oracle.estimate(self.truth, t, self.index)
+    def estimate(self, frame: Frame, t: float) -> TargetEstimate:
+        oracle = self.oracle.estimate(self.truth, t, frame.index)
         if self.tracker is None:
             return oracle
-        if self.index == 0:
-            self.tracker.init(image, self.truth, t)
+        if frame.index == 0:
+            self.tracker.init(frame.image, self.truth, t)
             return oracle
         if self._start is not None:
             box, self._start = self._start, None
-            return self.tracker.init(image, box, t)
-        return self.tracker.update(image, t)
+            return self.tracker.init(frame.image, box, t)
+        return self.tracker.update(frame.image, t)
 
 
 @dataclass
@@ -236,7 +235,7 @@ def run_prepared(loop: PreparedLoop, sinks: Seq[Sink] = (), listeners: Seq[can.L
             truth = iter(seq.groundtruth)
 
             def process(item: _Captured) -> None:
-                subject.truth, subject.index = item.box, item.index
+                subject.truth = item.box
                 loop.samples[item.index] = item.sample
                 record = closed.step(Frame(item.view, item.t, item.index), item.t)
                 steps.append(LoopStep(item.t - t0, item.sample, record.command))

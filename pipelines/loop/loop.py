@@ -17,8 +17,6 @@ from pipelines.control.controller import RateCommand
 from pipelines.loop.record import PAUSED, FrameRecord
 
 if TYPE_CHECKING:
-    import numpy as np
-
     from pipelines.control.controller import ControlConfig, Controller
     from pipelines.control.gimbal_link import GimbalLink
     from pipelines.loop.recording import Recorder
@@ -48,8 +46,8 @@ class Subject(Protocol):
     def start(self, box: Box) -> None:
         """Follow the subject in ``box`` from the next frame on (drop the current one)."""
 
-    def estimate(self, image: np.ndarray, t: float) -> TargetEstimate | None:
-        """The subject in this frame; None while none is chosen."""
+    def estimate(self, frame: Frame, t: float) -> TargetEstimate | None:
+        """The subject in ``frame``, taken at ``t`` on the loop's clock; None while none is chosen."""
 
 
 class Loop:
@@ -140,7 +138,7 @@ class Loop:
         """One frame captured at ``t``: submitted work, track, control, stream the setpoint, then
         the record to every sink."""
         notes = self._run_submitted()
-        estimate = self.subject.estimate(frame.image, t)
+        estimate = self.subject.estimate(frame, t)
         if self.paused:  # the gimbal holds: the keep-alive is stopped, nothing is sent
             command = RateCommand(0.0, 0.0, stamp=t, mode=PAUSED)
         else:

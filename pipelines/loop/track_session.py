@@ -127,8 +127,10 @@ class TrackSession:
         detector, tracker = subject
         confirmer = StartConfirmer(
             max_moving_fraction=CAMERA_MOTION_FRACTION if options.detect == "motion" else None)
+        # live and realtime frames carry monotonic capture times; fast file playback stamps on read
+        self._monotonic_stamps = source.is_live or options.realtime
         self.subject = AcquiringSubject(tracker, detector, source.size, roi=options.roi, pick=options.pick,
-                                        confirmer=confirmer)
+                                        confirmer=confirmer, video_time=not self._monotonic_stamps)
         self.camera = CameraModel(width, height, hfov_deg=options.hfov_deg)
         self.link = GimbalLink(client, rate_hz=options.rate_hz, signs=options.signs, bus_timeout=options.bus_timeout)
         self.recorder = Recorder(client, requested=options.record)
@@ -139,8 +141,6 @@ class TrackSession:
                          self.link, feedback=self.feedback, recorder=self.recorder,
                          video_fps=None if source.is_live else source.playback_fps,
                          dropped=lambda: source.dropped)
-        # live and realtime frames carry monotonic capture times; fast file playback stamps on read
-        self._monotonic_stamps = source.is_live or options.realtime
         self.reason = "running"
         self.error: str | None = None
         out = options.out_dir
@@ -190,10 +190,8 @@ class TrackSession:
 
     def step(self, frame: Frame) -> FrameRecord:
         """One frame through the loop, its outputs written."""
-        if self._monotonic_stamps:
-            return self.loop.step(frame, frame.timestamp)
-        self.subject.video_t = frame.timestamp
-        return self.loop.step(frame, self.loop.clock())
+        stamp = frame.timestamp if self._monotonic_stamps else self.loop.clock()
+        return self.loop.step(frame, stamp)
 
     # -- the end -------------------------------------------------------------------------
     def finish(self, reason: str | None = None, error: str | None = None) -> dict[str, Any]:

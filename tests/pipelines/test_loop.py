@@ -26,7 +26,7 @@ class Subject:
     def start(self, box) -> None:
         self.started.append(tuple(box))
 
-    def estimate(self, image, t):
+    def estimate(self, frame, t):
         self.threads.append(threading.current_thread())
         if t < 1.0:
             return None
