@@ -1,5 +1,5 @@
-"""What tests in several folders share: polling, running the CLI in a subprocess, a free UDP port
-and writing a video clip."""
+"""What tests in several folders share: polling, running the CLI in a subprocess, a free UDP port,
+writing a video clip and a sequence folder."""
 from __future__ import annotations
 
 import json
@@ -92,3 +92,11 @@ def write_clip(path: Path, images: Iterable[np.ndarray], fps: float, fourcc: str
     assert writer is not None, "no images to write"
     writer.release()
     return path
+
+
+def write_sequence_folder(folder: Path, frames: Iterable[np.ndarray], boxes: Iterable[Iterable[float]]) -> Path:
+    """An OTB-style sequence in ``folder``: ``1.png``, ``2.png``, ... and comma-separated ground truth."""
+    for i, image in enumerate(frames, start=1):
+        cv2.imwrite(str(folder / f"{i}.png"), image)
+    (folder / "groundtruth_rect.txt").write_text("".join(",".join(f"{v:.2f}" for v in b) + "\n" for b in boxes))
+    return folder

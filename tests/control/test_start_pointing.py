@@ -3,10 +3,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import cv2
 import pytest
 
 from pipelines.loop.closed_loop import LoopSettings, run_closed_loop
+from tests.support import write_sequence_folder
 from tracker.evaluation.synthetic import render_sequence
 
 
@@ -16,10 +16,7 @@ def edge_start(tmp_path_factory: pytest.TempPathFactory) -> Path:
     view a gimbal at rest would see (the case of dtb70_gull2)."""
     folder = tmp_path_factory.mktemp("edge_start")
     seq = render_sequence(frames=10, frame_size=(1280, 720), target=40, speed=4.0)
-    for i, image in enumerate(seq.frames, start=1):
-        cv2.imwrite(str(folder / f"{i}.png"), image)
-    (folder / "groundtruth_rect.txt").write_text("".join(",".join(f"{v:.2f}" for v in b) + "\n" for b in seq.boxes))
-    return folder
+    return write_sequence_folder(folder, seq.frames, seq.boxes)
 
 
 @pytest.mark.parametrize("tracker", ["oracle", "dcf"])
