@@ -22,7 +22,9 @@ from tracker.runtime.frames import as_bgr, as_bgr_or_grey
 class TrackingBackend(Protocol):
     """Follows one box from frame to frame; knows nothing about loss or re-acquisition. A backend
     may also offer ``likeness(frame, box)``: a box's likeness to the subject in its own features over
-    their typical value, which a re-acquisition must then reach (``NanoTrackBackend``)."""
+    their typical value, which a re-acquisition must then reach (``NanoTrackBackend``), and
+    ``anchor_likeness()``: the last box's likeness to the subject as first seen, over its early value,
+    which the subject tracker may require of a box before trusting it (``TrackerSettings.verify_deep``)."""
 
     name: str
 
@@ -53,6 +55,11 @@ class ConvertingBackend:
         (1 for a backend that cannot score boxes)."""
         score = getattr(self._backend, "likeness", None)
         return score(self._convert(frame), box) if score is not None else 1.0
+
+    def anchor_likeness(self) -> float:
+        """The wrapped backend's ``anchor_likeness()`` (1 for a backend without one)."""
+        anchor = getattr(self._backend, "anchor_likeness", None)
+        return anchor() if anchor is not None else 1.0
 
 
 class OpenCvBackend:

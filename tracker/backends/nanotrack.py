@@ -63,6 +63,9 @@ class NanoTrackParams:
     likeness_learn_above: float = 0.6
     likeness_full: float = 0.75
     likeness_zero: float = 0.5
+    # ``anchor_likeness``'s reference: the typical likeness as it stands this many frames after a start,
+    # then held, so that a box settled on something else cannot drag it down (the running value can).
+    reference_frames: int = 10
 
 
 #: The reference tracker's settings for v3 (SiamTrackers), without our motion prediction or size
@@ -322,6 +325,9 @@ class NanoTrackBackend:
         self._fill = (0.0, 0.0, 0.0)
         self._subject_features = np.zeros((1, 1, 1), np.float32)  # the template's cells under the subject
         self._typical_likeness = 0.0
+        self._reference_likeness = 0.0  # the typical likeness reference_frames after the start, held
+        self._last_likeness = 0.0  # the last box's deep likeness to the subject
+        self._updates = 0  # since the last start
         self._ready = False
 
     def init(self, frame: np.ndarray, box: Box) -> None:
@@ -336,6 +342,7 @@ class NanoTrackBackend:
         cells = np.clip(np.round(self._size * EXEMPLAR_SIZE / side / STRIDE), 1, TEMPLATE_FEATURES).astype(int)
         self._subject_features = sample_cells(template[0], TEMPLATE_MIDDLE, (int(cells[0]), int(cells[1])))
         self._typical_likeness = 0.0
+        self._updates = 0
         self._ready = True
         self._calibration = self._measure_size_calibration(frame)
         self._size = self._size / self._calibration  # tracked in the network's own size
@@ -353,8 +360,19 @@ class NanoTrackBackend:
         self._center = center
         self._size = np.clip(size, MIN_SIZE, frame_size)
         (cx, cy), (w, h) = self._center, np.minimum(self._size * self._calibration, frame_size)
-        score = np.clip(peak.score, 0, 1) * self._relative_likeness(peak.likeness(self._subject_features))
+        self._last_likeness = peak.likeness(self._subject_features)
+        score = np.clip(peak.score, 0, 1) * self._relative_likeness(self._last_likeness)
+        self._updates += 1
+        if self._updates <= self.params.reference_frames:
+            self._reference_likeness = self._typical_likeness
         return from_center(float(cx), float(cy), float(w), float(h)), float(score)
+
+    def anchor_likeness(self) -> float:
+        """The last box's deep likeness to the subject over its typical value in the first
+        ``reference_frames`` after the start, held from then on (1 before any update). Unlike the
+        score's running reference, it does not follow a box that has settled on a cover or on
+        background, so it tells the subject tracker whether the box still holds the subject."""
+        return self._last_likeness / self._reference_likeness if self._reference_likeness > 0 else 1.0
 
     @property
     def size_calibration(self) -> np.ndarray:

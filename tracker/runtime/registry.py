@@ -13,7 +13,7 @@ from tracker.runtime.subject import SubjectTracker, TrackerSettings
 #: The default: the correlation filter. NanoTrack v3 scores higher on the 19 shared sequences
 #: (docs/tracker.md) but on the suite's rendered occlusion clips it goes on saying "tracking" after
 #: the subject has gone, and a gimbal must not chase background; it is there by name.
-DEFAULT_BACKEND = "dcf"
+DEFAULT_BACKEND = "nanotrack3"
 DEFAULT_WITH_MODELS = "nanotrack"  # the default when the model folder holds NanoTrack v2's files
 #: The model tracker whose files ship inside the package, so that it needs no model folder.
 EMBEDDED_TRACKER = "nanotrack3"
@@ -25,7 +25,8 @@ EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # gate: the pixel likeness sank on turning subjects and pulled a subject the network still held
 # under the gate (docs/tracker-lab.md, "How the default was chosen").
 _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1),
-             "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0)}
+             "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85,
+                                                adapt_pixel=0.6)}
 
 
 def available_trackers() -> list[str]:

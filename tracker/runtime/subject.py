@@ -33,11 +33,21 @@ class TrackerSettings:
     reacquire_deep_likeness: float = 0.6  # ... and the backend's own likeness ratio for it at least this
     adapt_confidence: float = 0.6  # the adaptive template learns only above this
     adapt_rate: float = 0.05
+    # ... and only from frames whose pixel likeness reaches this (with the pixel likeness out of the
+    # confidence, a subject sliding behind a cover would teach its size and look the cover's)
+    adapt_pixel: float = 0.0
     lost_after_frames: int = 15  # consecutive low-confidence frames before declaring LOST
     refine_reach: float = 0.1  # a confident box's centre is re-matched within this many box sizes ...
     refine_blend: float = 0.5  # ... and moved this far towards the match
     search_reach: float = 1.0  # local search radius in box sizes, growing while searching
     max_reach: float = 4.0
+    # A check that the backend's box still holds the subject, for backends whose own score stays high on
+    # a cover or on background: with verify_deep > 0 a box is trusted only when the backend's anchor
+    # likeness (its features under the box against the subject as first seen, over their early value)
+    # reaches verify_deep or the pixel likeness reaches verify_pixel. An unverified box is a miss, its
+    # confidence the backend's score times the pixel likeness in full. 0: off (every box is verified).
+    verify_deep: float = 0.0
+    verify_pixel: float = 0.3
 
 
 class SubjectTracker:
@@ -91,7 +101,10 @@ class SubjectTracker:
         patch = cut_patch(frame, box) if box is not None else None
         similarity = self._appearance.similarity(patch) if patch is not None else 0.0
         confidence = backend_score * similarity ** s.pixel_weight
-        if box is not None and confidence >= s.track_confidence:
+        verified = self._holds_subject(similarity)
+        if not verified:
+            confidence = min(confidence, backend_score * similarity)
+        if box is not None and verified and confidence >= s.track_confidence:
             return self._accept(frame, box, patch, similarity, confidence, timestamp)
         self._misses += 1
         found = self._search(frame, predicted) if self._misses >= s.reacquire_after_frames else Match(predicted, 0.0)
@@ -107,6 +120,14 @@ class SubjectTracker:
             self._kalman.correct(box, confidence)
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
+    def _holds_subject(self, similarity: float) -> bool:
+        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off)."""
+        s = self.settings
+        if s.verify_deep <= 0.0 or similarity >= s.verify_pixel:
+            return True
+        anchor = getattr(self._backend, "anchor_likeness", None)
+        return anchor is None or anchor() >= s.verify_deep
+
     def _backend_likes(self, frame: np.ndarray, box: Box) -> bool:
         """Whether the backend's own likeness of ``box`` to the subject (relative to its typical
         value; backends that cannot score boxes say 1) reaches ``reacquire_deep_likeness``."""
@@ -118,7 +139,7 @@ class SubjectTracker:
                 timestamp: float) -> TargetEstimate:
         s = self.settings
         self._misses = 0
-        if confidence >= s.adapt_confidence:
+        if confidence >= s.adapt_confidence and similarity >= s.adapt_pixel:
             self._confident_frames += 1
             rate = max(s.adapt_rate, 1.0 / self._confident_frames)
             self._typical_likeness += rate * (similarity - self._typical_likeness)
