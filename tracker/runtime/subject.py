@@ -41,13 +41,19 @@ class TrackerSettings:
     refine_blend: float = 0.5  # ... and moved this far towards the match
     search_reach: float = 1.0  # local search radius in box sizes, growing while searching
     max_reach: float = 4.0
+    search_scales: tuple[float, ...] = (1.0,)  # the search's box sizes, as shares of the subject's last one
     # A check that the backend's box still holds the subject, for backends whose own score stays high on
     # a cover or on background: with verify_deep > 0 a box is trusted only when the backend's anchor
     # likeness (its features under the box against the subject as first seen, over their early value)
-    # reaches verify_deep or the pixel likeness reaches verify_pixel. An unverified box is a miss, its
-    # confidence the backend's score times the pixel likeness in full. 0: off (every box is verified).
+    # reaches verify_deep or (not straight after a miss) the pixel likeness reaches verify_pixel. An
+    # unverified box is a miss, its confidence the backend's score times the pixel likeness in full.
+    # 0: off (every box is verified).
     verify_deep: float = 0.0
     verify_pixel: float = 0.3
+    # After misses, a box at the frame's edge is taken back only once its width and height are at least
+    # this share of the subject's size: the part in view of a subject coming back in is no measure of
+    # its size, and a backend that took the sliver up grows its box only slowly. 0: off.
+    return_size_ratio: float = 0.0
 
 
 class SubjectTracker:
@@ -101,7 +107,7 @@ class SubjectTracker:
         patch = cut_patch(frame, box) if box is not None else None
         similarity = self._appearance.similarity(patch) if patch is not None else 0.0
         confidence = backend_score * similarity ** s.pixel_weight
-        verified = self._holds_subject(similarity)
+        verified = self._holds_subject(similarity) and not (box is not None and self._a_sliver(frame, box))
         if not verified:
             confidence = min(confidence, backend_score * similarity)
         if box is not None and verified and confidence >= s.track_confidence:
@@ -121,12 +127,26 @@ class SubjectTracker:
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
     def _holds_subject(self, similarity: float) -> bool:
-        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off)."""
+        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off).
+        After a miss only the backend's anchor likeness takes a box back: the pixel likeness of a
+        subject half out of the picture flickered over ``verify_pixel`` and back."""
         s = self.settings
-        if s.verify_deep <= 0.0 or similarity >= s.verify_pixel:
+        if s.verify_deep <= 0.0 or (similarity >= s.verify_pixel and self._misses == 0):
             return True
         anchor = getattr(self._backend, "anchor_likeness", None)
         return anchor is None or anchor() >= s.verify_deep
+
+    def _a_sliver(self, frame: np.ndarray, box: Box) -> bool:
+        """Whether ``box``, after misses, is at the frame's edge and smaller than ``return_size_ratio``
+        of the subject's size: the part in view of a subject coming back into the picture."""
+        ratio = self.settings.return_size_ratio
+        if ratio <= 0.0 or self._misses == 0:
+            return False
+        (w, h), (x, y, bw, bh) = self._size, box
+        height, width = frame.shape[:2]
+        margin = 0.1 * max(w, h)
+        at_edge = x <= margin or y <= margin or x + bw >= width - margin or y + bh >= height - margin
+        return at_edge and (bw < ratio * w or bh < ratio * h)
 
     def _backend_likes(self, frame: np.ndarray, box: Box) -> bool:
         """Whether the backend's own likeness of ``box`` to the subject (relative to its typical
@@ -166,10 +186,13 @@ class SubjectTracker:
 
     def _search(self, frame: np.ndarray, predicted: Box) -> Match:
         """Template search around the prediction, widening while the subject stays unseen, for a
-        box of the subject's size on its last confident frame."""
+        box of the subject's size on its last confident frame (times each of ``search_scales``: a
+        subject may come back from behind a cover nearer or farther, as on the demo clip)."""
         s = self.settings
         reach = min(s.max_reach, s.search_reach * (1.0 + 0.25 * self._misses))
-        best = self._appearance.search(frame, predicted, self._size, reach)
+        w, h = self._size
+        best = max((self._appearance.search(frame, predicted, (w * k, h * k), reach / k) for k in s.search_scales),
+                   key=lambda match: match.score)
         if self._detector is not None and self._misses > s.lost_after_frames:
             for detection in self._detector.detect(frame):
                 found = self._in_detection(frame, detection.box)
