@@ -75,8 +75,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
-                         "is nanotrack when --model-dir holds its files, else dcf; nanotrack3 runs on the model files "
-                         "shipped with gimbaltrack)")
+                         "is nanotrack when --model-dir holds its files, else nanotrack3 on the model files shipped with "
+                         "gimbaltrack, or dcf where they cannot be loaded)")
     subject.add_argument("--model-dir", type=existing_dir,
                          help="folder with optional model files: NanoTrack v3 (instead of the shipped ones), "
                          "NanoTrack v2, VitTrack, FEAR-XS and YuNet (then the face detector)")

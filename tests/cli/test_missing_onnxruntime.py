@@ -1,5 +1,6 @@
 """A model tracker asked for on a machine without onnxruntime: one line naming what is missing and
 the way out, exit 2, no traceback; nothing written for ``track`` (the tracker is made before --out)."""
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -36,3 +37,15 @@ def test_track_names_the_missing_runtime_before_writing_anything(tmp_path: Path)
     lines = done.stderr.strip().splitlines()
     assert done.returncode == 2 and "onnxruntime" in lines[-1] and "Traceback" not in done.stderr, done.stderr
     assert not out.exists()
+
+
+def test_eval_falls_back_to_dcf_with_one_warning_line_and_names_it(tmp_path: Path) -> None:
+    """The default tracker's model needs onnxruntime: without it ``eval`` runs ``dcf``, says so once,
+    and its JSON names the tracker that ran."""
+    sequence = write_otb(tmp_path / "seq", frames=3)
+    done = without_onnxruntime("eval", str(sequence), "--json")
+    assert done.returncode == 0, done.stderr
+    warnings = [line for line in done.stderr.splitlines() if "warning" in line]
+    assert len(warnings) == 1 and "Traceback" not in done.stderr, done.stderr
+    assert "nanotrack3" in warnings[0] and "onnxruntime" in warnings[0] and warnings[0].endswith("using dcf")
+    assert json.loads(done.stdout.splitlines()[-1])["tracker"] == "dcf"

@@ -16,8 +16,8 @@ from tracker.runtime import registry
 from tracker.runtime.registry import DEFAULT_BACKEND, EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
 
 
-# NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir. The
-# default stays the correlation filter (docs/tracker.md says why).
+# NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir, and is
+# the default; where its model cannot be loaded the default is the correlation filter, with a warning.
 def test_nanotrack3_runs_on_the_embedded_model_files_with_their_licence():
     subject = make_tracker(EMBEDDED_TRACKER)
     assert subject.name == "nanotrack3" and subject.model == str(EMBEDDED_MODELS)
@@ -31,9 +31,22 @@ def test_the_package_data_ships_the_model_folder():
     assert '"tracker" = ["models/*/*"]' in text
 
 
-def test_the_default_is_the_correlation_filter_without_a_model_folder():
+def test_the_default_is_nanotrack3_on_the_shipped_files_without_a_model_folder():
     subject = make_tracker()
+    assert subject.name == "nanotrack3" and subject.model == str(EMBEDDED_MODELS)
+
+
+@pytest.mark.parametrize("damage", ["missing", "junk"])
+def test_the_default_falls_back_to_dcf_with_a_warning_where_its_model_cannot_load(tmp_path, monkeypatch, damage):
+    shutil.copytree(EMBEDDED_MODELS, tmp_path / "models")
+    head = tmp_path / "models" / "nanotrack_v3" / "nanotrack_head.onnx"
+    head.unlink() if damage == "missing" else head.write_bytes(b"junk!")
+    monkeypatch.setattr(registry, "EMBEDDED_MODELS", tmp_path / "models")
+    with pytest.warns(registry.TrackerFallbackWarning, match="nanotrack_head.*; using dcf$"):
+        subject = make_tracker()
     assert subject.name == "dcf" and subject.model is None
+    with pytest.raises((ValueError, FileNotFoundError), match="nanotrack_head"):  # asked for by name: an error
+        make_tracker(EMBEDDED_TRACKER)
 
 
 def test_a_damaged_embedded_file_is_named(tmp_path, monkeypatch):
