@@ -54,7 +54,7 @@ def contenders(model_dir: Path | None) -> dict[str, object]:
     table = {f"opencv-{n}": (lambda n=n: BareBackend(make_backend(n, model_dir))) for n in ("mil", "kcf", "csrt")}
     table["gimbaltrack csrt-fast"] = lambda: make_tracker("csrt-fast")
     table["dcf backend alone"] = lambda: BareBackend(make_backend("dcf"))
-    table["gimbaltrack default (no models: dcf)"] = lambda: make_tracker("default")
+    table["gimbaltrack dcf (no models)"] = lambda: make_tracker("dcf")
     table[f"gimbaltrack {EMBEDDED_TRACKER} (embedded model files)"] = lambda: make_tracker(EMBEDDED_TRACKER)
     if model_dir is not None:
         table["opencv-nano"] = lambda: BareBackend(make_backend("nano", model_dir))
