@@ -28,13 +28,13 @@ EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # gate: the pixel likeness sank on turning subjects and pulled a subject the network still held
 # under the gate (docs/tracker-lab.md, "How the default was chosen"). Its score stays high on a cover
 # or on background, so a box must also pass the verification (verify_deep: its deep likeness to the
-# subject as first seen, or the pixel likeness), learns the look and size only where the pixels agree
-# (adapt_pixel), and takes a returning subject back at its size (return_size_ratio, search_scales; a
+# subject as first seen, or the pixel likeness), learns the size only where the pixels agree
+# (size_pixel), and takes a returning subject back at its size (return_size_ratio, search_scales; a
 # weaker template match is enough where its deep likeness is strong) (docs/tracker-lab.md, "Lost-state
 # reporting for nanotrack3").
 _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1),
              "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85,
-                                                adapt_pixel=0.6, return_size_ratio=0.85,
+                                                size_pixel=0.6, return_size_ratio=0.85,
                                                 search_scales=(0.8, 1.0, 1.25), reacquire_score=0.6, reacquire_deep_likeness=1.0)}
 
 

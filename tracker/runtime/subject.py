@@ -33,9 +33,10 @@ class TrackerSettings:
     reacquire_deep_likeness: float = 0.6  # ... and the backend's own likeness ratio for it at least this
     adapt_confidence: float = 0.6  # the adaptive template learns only above this
     adapt_rate: float = 0.05
-    # ... and only from frames whose pixel likeness reaches this (with the pixel likeness out of the
-    # confidence, a subject sliding behind a cover would teach its size and look the cover's)
-    adapt_pixel: float = 0.0
+    # The subject's size is learnt only from those frames whose pixel likeness reaches this too (with
+    # the pixel likeness out of the confidence, a box shrinking as the subject slid behind a cover
+    # taught the search a wrong size)
+    size_pixel: float = 0.0
     lost_after_frames: int = 15  # consecutive low-confidence frames before declaring LOST
     refine_reach: float = 0.1  # a confident box's centre is re-matched within this many box sizes ...
     refine_blend: float = 0.5  # ... and moved this far towards the match
@@ -45,9 +46,8 @@ class TrackerSettings:
     # A check that the backend's box still holds the subject, for backends whose own score stays high on
     # a cover or on background: with verify_deep > 0 a box is trusted only when the backend's anchor
     # likeness (its features under the box against the subject as first seen, over their early value)
-    # reaches verify_deep or (not straight after a miss) the pixel likeness reaches verify_pixel. An
-    # unverified box is a miss, its confidence the backend's score times the pixel likeness in full.
-    # 0: off (every box is verified).
+    # reaches verify_deep or the pixel likeness reaches verify_pixel. An unverified box is a miss, its
+    # confidence the backend's score times the pixel likeness in full. 0: off (every box is verified).
     verify_deep: float = 0.0
     verify_pixel: float = 0.3
     # After misses, a box at the frame's edge is taken back only once its width and height are at least
@@ -127,11 +127,9 @@ class SubjectTracker:
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
     def _holds_subject(self, similarity: float) -> bool:
-        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off).
-        After a miss only the backend's anchor likeness takes a box back: the pixel likeness of a
-        subject half out of the picture flickered over ``verify_pixel`` and back."""
+        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off)."""
         s = self.settings
-        if s.verify_deep <= 0.0 or (similarity >= s.verify_pixel and self._misses == 0):
+        if s.verify_deep <= 0.0 or similarity >= s.verify_pixel:
             return True
         anchor = getattr(self._backend, "anchor_likeness", None)
         return anchor is None or anchor() >= s.verify_deep
@@ -159,11 +157,12 @@ class SubjectTracker:
                 timestamp: float) -> TargetEstimate:
         s = self.settings
         self._misses = 0
-        if confidence >= s.adapt_confidence and similarity >= s.adapt_pixel:
+        if confidence >= s.adapt_confidence:
             self._confident_frames += 1
             rate = max(s.adapt_rate, 1.0 / self._confident_frames)
             self._typical_likeness += rate * (similarity - self._typical_likeness)
-            self._size = (box[2], box[3])  # not a box shrinking as the subject slides out of sight
+            if similarity >= s.size_pixel:
+                self._size = (box[2], box[3])  # not a box shrinking as the subject slides out of sight
             self._appearance.adapt(patch, s.adapt_rate)  # the patch the similarity was measured on
         if s.refine_blend > 0:
             box = self._refine(frame, box)
