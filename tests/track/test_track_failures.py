@@ -162,6 +162,7 @@ def _wait_for(predicate, timeout: float, what: str) -> None:  # type: ignore[no-
     ([signal.SIGINT], 130, "interrupted (SIGINT)"),
     ([signal.SIGTERM], 143, "terminated (SIGTERM)"),
     ([signal.SIGHUP], 129, "terminated (SIGHUP)"),  # the terminal closed
+    ([signal.SIGQUIT], 131, "terminated (SIGQUIT)"),  # Ctrl-\ (docs/track.md's exit codes)
     ([signal.SIGINT, signal.SIGINT], 130, "interrupted (SIGINT)"),  # an impatient second Ctrl-C
 ])
 def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: list[int], code: int,
