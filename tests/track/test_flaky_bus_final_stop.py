@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import signal
-import subprocess
 import threading
 import time
 from collections.abc import Iterator
@@ -21,7 +20,14 @@ from gimbal.log_decode import GIMBAL_TO_HOST
 from gimbal.messages.motion import SPEED_HOLD, SPEED_RELEASE
 from gimbal.session import STOP_RESEND_S, STOP_RETRY_S
 from tests.support import cli_command, free_udp_port, subprocess_env, wait_until
-from tests.track.helpers import DEMO, DEMO_ROI, decoded, host_commands, start, track_command
+from tests.track.helpers import (
+    DEMO,
+    DEMO_ROI,
+    decoded,
+    host_commands,
+    start,
+    track_command,
+)
 
 GROUP = "239.74.163.26"
 STOPPED_WITHIN_S = 0.6
