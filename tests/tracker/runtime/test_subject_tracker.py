@@ -352,3 +352,39 @@ def test_an_offset_box_is_moved_halfway_onto_the_subject() -> None:
 def test_without_refinement_the_offset_stays() -> None:
     settled = _x_errors(refine_blend=0.0)[-10:]
     assert abs(np.mean(settled) - OFFSET) < 0.3, settled
+
+
+# The verification (``verify_deep``, on for nanotrack3): a backend that scores its box 1 on a cover
+# must also show that the box still holds the subject, by its anchor likeness or by the pixels.
+class _AnchoredBackend(ScriptedBackend):
+    """A scripted backend that also reports a fixed ``anchor_likeness()``."""
+
+    def __init__(self, answer, anchor: float) -> None:
+        super().__init__(answer)
+        self.anchor = anchor
+
+    def anchor_likeness(self) -> float:
+        return self.anchor
+
+
+def _states_on_a_cover(anchor: float, **settings: float) -> list[TrackState]:
+    """States while the backend answers the subject's last box with score 1 on a scene without it."""
+    seq = render_sequence(frames=2, seed=3)
+    backend = _AnchoredBackend(lambda n, restarts: (tuple(float(v) for v in seq.boxes[0]), 1.0), anchor)
+    subject = SubjectTracker("anchored", backend, None, TrackerSettings(pixel_weight=0.0, **settings))
+    subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    return [e.state for e in follow(subject, [empty_scene(3)] * 20)]
+
+
+def test_an_unverified_box_is_a_miss_however_high_the_backend_scores_it():
+    assert _states_on_a_cover(0.7, verify_deep=0.85)[-1] is TrackState.LOST
+    assert _states_on_a_cover(0.9, verify_deep=0.85) == [TrackState.TRACKING] * 20  # the deep check holds it
+    assert _states_on_a_cover(0.7) == [TrackState.TRACKING] * 20  # verification off: the score decides
+
+
+def test_the_pixels_verify_a_box_the_deep_check_doubts():
+    seq = render_sequence(frames=10, seed=3)
+    backend = _AnchoredBackend(lambda n, restarts: (tuple(float(v) for v in seq.boxes[n]), 1.0), 0.5)
+    subject = SubjectTracker("anchored", backend, None, TrackerSettings(pixel_weight=0.0, verify_deep=0.85))
+    subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    assert [e.state for e in follow(subject, seq.frames[1:])] == [TrackState.TRACKING] * 9
