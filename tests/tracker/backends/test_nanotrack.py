@@ -329,3 +329,18 @@ def test_files_that_pass_the_check_but_not_trackernano_are_a_value_error(
     with pytest.raises(ValueError, match=r"^OpenCV's TrackerNano cannot use .*nanotrack_backbone_sim.onnx "
                                          r"and .*nanotrack_head_sim.onnx: .*Assertion failed\) something$"):
         make_backend("nano", models)
+
+
+def test_nanotrack3s_anchor_likeness_falls_on_a_cover_where_its_score_does_not():
+    """On the rendered occlusion clip the network's box stays on the cover with a score near 1; the
+    likeness to the subject as first seen, over its early value held, is what tells them apart."""
+    from tracker.evaluation.synthetic import render_sequence
+    from tracker.runtime.registry import EMBEDDED_MODELS
+
+    seq = render_sequence(frames=46, occlusion=(25, 45), seed=1)
+    backend = make_backend("nanotrack3", EMBEDDED_MODELS)
+    backend.init(seq.frames[0], seq.boxes[0])
+    answers = [(backend.update(frame)[1], backend.anchor_likeness()) for frame in seq.frames[1:]]
+    assert min(anchor for _, anchor in answers[:10]) > 0.9  # the subject in view
+    hidden = answers[34:45]  # frames 35-45: the subject behind the cover
+    assert min(score for score, _ in hidden) > 0.9 and max(anchor for _, anchor in hidden) < 0.85
