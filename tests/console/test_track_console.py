@@ -2,8 +2,10 @@
 on the bus what it says (the CAN log); stop ends the run with status 0 and its outputs."""
 from __future__ import annotations
 
+import http.client
 import json
 import threading
+import time
 from pathlib import Path
 
 from gimbal.client import SPEED_RELEASE
@@ -167,3 +169,32 @@ def test_a_console_that_dies_stops_and_releases_the_gimbal(tmp_path: Path, monke
     assert summary["status"] == "output failed" and "console" in summary["error"]
     assert_stopped_at_end(decoded(out / "can.log"))
     assert len(read_telemetry(out / "telemetry.jsonl")) == summary["frames"] > 10
+
+
+def test_a_file_at_file_speed_runs_to_its_end_with_the_view_following(tmp_path: Path) -> None:
+    """No --realtime: the file is read as fast as the loop goes, the viewer is shown recent frames
+    all the way (not a queue behind the loop), and the run ends by itself with status 0."""
+    clip = make_clip(tmp_path / "clip.avi", FRAMES, drifting_slowly)
+    run = ConsoleRun(tmp_path, source=str(clip))
+    from tests.console.http_helpers import MjpegReader
+    seen: list[tuple[int, float]] = []  # (frame index, capture -> received s)
+    reader = MjpegReader(run.port, "?fps=30&width=320")
+    try:
+        while True:
+            try:
+                headers, data = reader.part()
+            except (EOFError, OSError, http.client.HTTPException):
+                break
+            seen.append((int(headers["x-frame-index"]), time.monotonic() - float(headers["x-capture-time"])))
+        code, _, stderr = run.finish()
+    finally:
+        reader.close()
+        run.kill()
+    assert code == 0, stderr
+    summary = run.summary()
+    assert summary["status"] == "end of source" and summary["frames"] == FRAMES
+    indexes = [index for index, _ in seen]
+    assert len(indexes) >= 10 and indexes == sorted(set(indexes)), indexes
+    assert indexes[-1] >= FRAMES * 0.8, indexes  # it followed the file to (near) its end
+    lags = sorted(lag for _, lag in seen)
+    assert lags[len(lags) // 2] < 1.0, lags  # each shown when it was new, not from a backlog
