@@ -10,6 +10,7 @@ from pathlib import Path
 
 from gimbal.client import SPEED_RELEASE
 from gimbal.messages.camera import CameraActionCode
+from pipelines.cli.track_cmd import EXIT_DEGRADED_LINK
 from pipelines.console.server import ConsoleServer
 from pipelines.outputs.telemetry import read_telemetry
 from tests.console.http_helpers import post, request
@@ -56,9 +57,8 @@ def test_each_control_acts_on_the_run_and_is_in_the_telemetry(tmp_path: Path) ->
         code, _, stderr = run.finish()
     finally:
         run.kill()
-    assert code == 0, stderr
-    summary = run.summary()
-    assert summary["status"] == "stopped from the console"
+    assert code == EXIT_DEGRADED_LINK, stderr
+    assert run.summary()["status"] == "stopped from the console"
     assert summary["settings"]["max_speed"] == 30 and summary["settings"]["kp"] == 6
     lines = read_telemetry(run.out / "telemetry.jsonl")
     actions = [(line["frame"], a) for line in lines for a in line.get("operator", [])]
@@ -198,3 +198,21 @@ def test_a_file_at_file_speed_runs_to_its_end_with_the_view_following(tmp_path: 
     assert indexes[-1] >= FRAMES * 0.8, indexes  # it followed the file to (near) its end
     lags = sorted(lag for _, lag in seen)
     assert lags[len(lags) // 2] < 1.0, lags  # each shown when it was new, not from a backlog
+
+
+def test_the_status_shows_refusals_timeouts_and_a_silent_gimbal(tmp_path: Path) -> None:
+    """The built-in simulator refuses some commands, then falls silent: the status counts the
+    NACKs, then the reply timeouts, and says the gimbal is silent. A stop then ends the run as
+    stopped, with the degraded link's exit status like any run that lost its gimbal."""
+    run = ConsoleRun(tmp_path, "--sim-faults", "nack=0.3,silent=4:60,seed=3")
+    try:
+        assert wait_until(lambda: state(run)["bus"]["nacks"] > 0, 20), state(run)["bus"]
+        assert state(run)["bus"]["silent"] is False and state(run)["bus"]["timeouts"] == 0
+        assert wait_until(lambda: state(run)["bus"]["silent"] and state(run)["bus"]["timeouts"] > 0, 20), \
+            state(run)["bus"]
+        assert post(run.port, "/api/stop")[0] == 200
+        code, _, stderr = run.finish()
+    finally:
+        run.kill()
+    assert code == EXIT_DEGRADED_LINK, stderr
+    assert run.summary()["status"] == "stopped from the console"
