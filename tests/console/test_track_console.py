@@ -99,6 +99,8 @@ def test_recenter_pauses_and_sends_the_gimbal_home(tmp_path: Path) -> None:
     finally:
         run.kill()
     assert code == 0, stderr
+    lines = read_telemetry(run.out / "telemetry.jsonl")
+    assert [a["action"] for line in lines for a in line.get("operator", [])] == ["recenter", "stop"]
     sent = host_commands(decoded(run.out / "can.log"))
     names = [r["name"] for r in sent]
     recenter = names.index("recenter_selfie")
