@@ -13,7 +13,7 @@ from gimbal.messages.camera import CameraActionCode
 from pipelines.cli.track_cmd import EXIT_DEGRADED_LINK
 from pipelines.console.server import ConsoleServer
 from pipelines.outputs.telemetry import read_telemetry
-from tests.console.http_helpers import post, request
+from tests.console.http_helpers import MjpegReader, post, request
 from tests.console.track_run import FRAMES, ConsoleRun, drifting_slowly, subject_box
 from tests.support import wait_until
 from tests.track.helpers import (
@@ -57,8 +57,9 @@ def test_each_control_acts_on_the_run_and_is_in_the_telemetry(tmp_path: Path) ->
         code, _, stderr = run.finish()
     finally:
         run.kill()
-    assert code == EXIT_DEGRADED_LINK, stderr
-    assert run.summary()["status"] == "stopped from the console"
+    assert code == 0, stderr
+    summary = run.summary()
+    assert summary["status"] == "stopped from the console"
     assert summary["settings"]["max_speed"] == 30 and summary["settings"]["kp"] == 6
     lines = read_telemetry(run.out / "telemetry.jsonl")
     actions = [(line["frame"], a) for line in lines for a in line.get("operator", [])]
@@ -113,7 +114,6 @@ def test_closing_every_view_changes_nothing_and_a_bad_request_changes_nothing(tm
     run = ConsoleRun(tmp_path)
     try:
         assert wait_until(lambda: (state(run)["frame"] or 0) >= 5, 30)
-        from tests.console.http_helpers import MjpegReader
         reader = MjpegReader(run.port)
         reader.part()
         reader.close()
@@ -178,7 +178,6 @@ def test_a_file_at_file_speed_runs_to_its_end_with_the_view_following(tmp_path: 
     all the way (not a queue behind the loop), and the run ends by itself with status 0."""
     clip = make_clip(tmp_path / "clip.avi", FRAMES, drifting_slowly)
     run = ConsoleRun(tmp_path, source=str(clip))
-    from tests.console.http_helpers import MjpegReader
     seen: list[tuple[int, float]] = []  # (frame index, capture -> received s)
     reader = MjpegReader(run.port, "?fps=30&width=320")
     try:
