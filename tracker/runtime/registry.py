@@ -33,9 +33,9 @@ EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # weaker template match is enough where its deep likeness is strong) (docs/tracker-lab.md, "Lost-state
 # reporting for nanotrack3").
 _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1),
-             "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85,
-                                                size_pixel=0.6, return_size_ratio=0.85,
-                                                search_scales=(0.8, 1.0, 1.25), reacquire_score=0.6, reacquire_deep_likeness=1.0)}
+             "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85, size_pixel=0.6,
+                                           return_size_ratio=0.85, search_scales=(0.8, 1.0, 1.25),
+                                           reacquire_score=0.6, reacquire_deep_likeness=1.0)}
 
 
 def available_trackers() -> list[str]:
