@@ -9,6 +9,7 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from tracker.backends.arbiter import FusedBackend
 from tracker.backends.dcf import DcfBackend
 from tracker.backends.fear import FearBackend
 from tracker.backends.nanotrack import (V3_PARAMS, NanoTrackBackend, OrtNanoNetworks, load_nanotrack_networks,
@@ -125,10 +126,10 @@ def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
 _NANO_PROBE_BOX = 32  # side of the box the model-file check starts TrackerNano on, pixels
 
 
-BACKEND_NAMES = ("dcf", "nanotrack", "nanotrack3", "vittrack", "fear", "csrt-fast", "csrt", "kcf", "mil", "mosse",
+BACKEND_NAMES = ("dcf", "nanotrack", "nanotrack3", "nanovit", "vittrack", "fear", "csrt-fast", "csrt", "kcf", "mil", "mosse",
                  "nano")
-# Backends that need model files (``model_dir``); the last three run on onnxruntime.
-MODEL_BACKENDS = ("nanotrack", "nano", "nanotrack3", "vittrack", "fear")
+# Backends that need model files (``model_dir``); the last four run on onnxruntime.
+MODEL_BACKENDS = ("nanotrack", "nano", "nanotrack3", "nanovit", "vittrack", "fear")
 # OpenCV's KCF and Nano fail on grey frames; the others take grey as it is (cheaper than three channels).
 NEEDS_BGR = ("kcf", "nano")
 
@@ -147,6 +148,9 @@ def _bare_backend(name: str, model_dir: str | Path | None, threads: int) -> Trac
         return NanoTrackBackend(model_dir)
     if name == "nanotrack3":
         return NanoTrackBackend(model_dir, V3_PARAMS, OrtNanoNetworks(model_dir, threads), name)
+    if name == "nanovit":
+        nano = NanoTrackBackend(model_dir, V3_PARAMS, OrtNanoNetworks(model_dir, threads), "nanotrack3")
+        return FusedBackend(nano, VitTrackBackend(model_dir, threads=threads), name=name)
     if name == "vittrack":
         return VitTrackBackend(model_dir, threads=threads)
     if name == "fear":

@@ -25,7 +25,8 @@ EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # gate: the pixel likeness sank on turning subjects and pulled a subject the network still held
 # under the gate (docs/tracker-lab.md, "How the default was chosen").
 _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1),
-             "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0)}
+             "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0),
+             "nanovit": TrackerSettings(track_confidence=0.1, pixel_weight=0.0)}  # its score is NanoTrack v3's
 
 
 def available_trackers() -> list[str]:
