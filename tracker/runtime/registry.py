@@ -17,6 +17,8 @@ DEFAULT_BACKEND = "dcf"
 DEFAULT_WITH_MODELS = "nanotrack"  # the default when the model folder holds NanoTrack v2's files
 #: The model tracker whose files ship inside the package, so that it needs no model folder.
 EMBEDDED_TRACKER = "nanotrack3"
+#: Every model tracker that runs on the shipped files alone (``nanovit``: NanoTrack v3's and VitTrack's).
+EMBEDDED_TRACKERS = (EMBEDDED_TRACKER, "nanovit")
 EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # The template refinement corrects CSRT's drift; the correlation filter's own peak is finer. The
 # template search may restart dcf only once the subject is lost: dcf keeps following through a few
@@ -31,7 +33,7 @@ _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=Tra
 
 def available_trackers() -> list[str]:
     """Names ``make_tracker`` accepts; those in ``MODEL_BACKENDS`` read model files (``nanotrack3``'s
-    ship with the package)."""
+    and ``nanovit``'s ship with the package)."""
     return ["default", *BACKEND_NAMES]
 
 
@@ -41,7 +43,7 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
     ``threads``: onnxruntime's intra-op threads for the models that run on it.
 
     ``default`` is NanoTrack (v2) when ``model_dir`` holds its files, else the correlation filter.
-    ``EMBEDDED_TRACKER`` reads the files shipped with the package where ``model_dir`` is not given;
+    ``EMBEDDED_TRACKERS`` read the files shipped with the package where ``model_dir`` is not given;
     other model trackers need it. Unknown names raise ``ValueError``; missing model files, or a
     ``model_dir`` that is no folder, raise ``FileNotFoundError``; a damaged one ``ValueError``.
     """
@@ -50,7 +52,7 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
         name = DEFAULT_WITH_MODELS if model_dir is not None and _has_nanotrack(model_dir) else DEFAULT_BACKEND
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
-    if model_dir is None and name == EMBEDDED_TRACKER:
+    if model_dir is None and name in EMBEDDED_TRACKERS:
         model_dir = EMBEDDED_MODELS
     backend = make_backend(name, model_dir, threads)  # missing model files fail here, not on init()
     model = str(model_dir) if name in MODEL_BACKENDS else None
