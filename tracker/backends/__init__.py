@@ -12,8 +12,8 @@ import numpy as np
 from tracker.backends.arbiter import FusedBackend
 from tracker.backends.dcf import DcfBackend
 from tracker.backends.fear import FearBackend
-from tracker.backends.nanotrack import (V3_PARAMS, NanoTrackBackend, OrtNanoNetworks, load_nanotrack_networks,
-                               nanotrack_model_files)
+from tracker.backends.nanotrack import (NANOVIT_PARAMS, V3_PARAMS, NanoTrackBackend, OrtNanoNetworks,
+                                        load_nanotrack_networks, nanotrack_model_files)
 from tracker.backends.onnx_sessions import DEFAULT_THREADS
 from tracker.backends.vittrack import VitTrackBackend
 from tracker.runtime.boxes import Box, cut_to_frame
@@ -149,7 +149,7 @@ def _bare_backend(name: str, model_dir: str | Path | None, threads: int) -> Trac
     if name == "nanotrack3":
         return NanoTrackBackend(model_dir, V3_PARAMS, OrtNanoNetworks(model_dir, threads), name)
     if name == "nanovit":
-        nano = NanoTrackBackend(model_dir, V3_PARAMS, OrtNanoNetworks(model_dir, threads), "nanotrack3")
+        nano = NanoTrackBackend(model_dir, NANOVIT_PARAMS, OrtNanoNetworks(model_dir, threads), "nanotrack3")
         return FusedBackend(nano, VitTrackBackend(model_dir, threads=threads), name=name)
     if name == "vittrack":
         return VitTrackBackend(model_dir, threads=threads)
