@@ -9,7 +9,7 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from tracker.backends.arbiter import FusedBackend
+from tracker.backends.fused import FusedBackend
 from tracker.backends.dcf import DcfBackend
 from tracker.backends.fear import FearBackend
 from tracker.backends.nanotrack import (NANOVIT_PARAMS, V3_PARAMS, NanoTrackBackend, OrtNanoNetworks,

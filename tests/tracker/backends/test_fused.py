@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from tests import fake_onnx
-from tracker.backends.arbiter import FusedBackend, FusionParams
+from tracker.backends.fused import FusedBackend, FusionParams
 from tracker.backends.nanotrack import V3_PARAMS, NanoTrackBackend, OrtNanoNetworks
 from tracker.backends.vittrack import VitTrackBackend
 from tracker.runtime.boxes import center
