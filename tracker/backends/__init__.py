@@ -126,8 +126,8 @@ def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
 _NANO_PROBE_BOX = 32  # side of the box the model-file check starts TrackerNano on, pixels
 
 
-BACKEND_NAMES = ("dcf", "nanotrack", "nanotrack3", "nanovit", "vittrack", "fear", "csrt-fast", "csrt", "kcf", "mil", "mosse",
-                 "nano")
+BACKEND_NAMES = ("dcf", "nanotrack", "nanotrack3", "nanovit", "vittrack", "fear", "csrt-fast", "csrt", "kcf", "mil",
+                 "mosse", "nano")
 # Backends that need model files (``model_dir``); the last four run on onnxruntime.
 MODEL_BACKENDS = ("nanotrack", "nano", "nanotrack3", "nanovit", "vittrack", "fear")
 # OpenCV's KCF and Nano fail on grey frames; the others take grey as it is (cheaper than three channels).

@@ -5,7 +5,8 @@ foreground score stays high on background; VitTrack loses more subjects for good
 confidence means something. So NanoTrack follows every frame, VitTrack searches around NanoTrack's
 box on the same frame, and where VitTrack's windowed confidence is ``fuse_above`` or more the box
 is the weighted mean of the two (their errors are partly independent, so the mean is closer to the
-subject on most sequences: docs/tracker-lab.md); elsewhere NanoTrack's box stands. The score is
+subject on most sequences: docs/tracker-lab.md); elsewhere NanoTrack's box stands. NanoTrack keeps
+its own state: searching from the fused box instead lost subjects it had held. The score is
 NanoTrack's, so the subject tracker's confidence gate and lost-subject reporting stay as they are
 for ``nanotrack3``.
 """
@@ -26,7 +27,6 @@ class FusionParams:
 
     fuse_above: float = 0.2  # VitTrack's windowed confidence from which its box is averaged in
     vit_weight: float = 0.5  # its weight in the mean
-    follow_fused: bool = False  # NanoTrack searches around the fused box next (else around its own)
 
 
 class FusedBackend:
@@ -53,10 +53,7 @@ class FusedBackend:
         if checked is None or confidence < self.params.fuse_above:
             return box, score
         weight = self.params.vit_weight
-        fused = tuple(float((1 - weight) * a + weight * b) for a, b in zip(box, checked))
-        if self.params.follow_fused:
-            self._primary.relocate(fused)
-        return fused, score
+        return tuple(float((1 - weight) * a + weight * b) for a, b in zip(box, checked)), score
 
     def likeness(self, frame: np.ndarray, box: Box) -> float:
         """The primary's likeness of ``box`` to the subject (see ``NanoTrackBackend.likeness``)."""

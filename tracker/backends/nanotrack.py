@@ -63,13 +63,6 @@ class NanoTrackParams:
     likeness_learn_above: float = 0.6
     likeness_full: float = 0.75
     likeness_zero: float = 0.5
-    # Template update: the head is given (1 - template_weight) x the first template + template_weight x
-    # a running average (rate template_rate) of templates cut every template_every frames where the
-    # peak's penalised score is template_above or more (template_weight 0: the first template only).
-    template_weight: float = 0.0
-    template_rate: float = 0.1
-    template_every: int = 5
-    template_above: float = 0.8
 
 
 #: The reference tracker's settings for v3 (SiamTrackers), without our motion prediction or size
@@ -343,9 +336,6 @@ class NanoTrackBackend:
         side = self._context_side()
         template = self._template(frame, self._center, side)
         self._networks.set_template(template)
-        self._first_template = template
-        self._recent_template = template
-        self._frames = 0
         cells = np.clip(np.round(self._size * EXEMPLAR_SIZE / side / STRIDE), 1, TEMPLATE_FEATURES).astype(int)
         self._subject_features = sample_cells(template[0], TEMPLATE_MIDDLE, (int(cells[0]), int(cells[1])))
         self._typical_likeness = 0.0
@@ -367,26 +357,7 @@ class NanoTrackBackend:
         self._size = np.clip(size, MIN_SIZE, frame_size)
         (cx, cy), (w, h) = self._center, np.minimum(self._size * self._calibration, frame_size)
         score = np.clip(peak.score, 0, 1) * self._relative_likeness(peak.likeness(self._subject_features))
-        self._frames += 1
-        if (self.params.template_weight > 0 and self._frames % self.params.template_every == 0
-                and peak.score * peak.penalty >= self.params.template_above):
-            self._update_template(frame)
         return from_center(float(cx), float(cy), float(w), float(h)), float(score)
-
-    def _update_template(self, frame: np.ndarray) -> None:
-        """Blend a template cut at the current box into the running one and hand the head the mix."""
-        p = self.params
-        template = self._template(frame, self._center, self._context_side())
-        self._recent_template = (1 - p.template_rate) * self._recent_template + p.template_rate * template
-        self._networks.set_template((1 - p.template_weight) * self._first_template
-                                    + p.template_weight * self._recent_template)
-
-    def relocate(self, box: Box) -> None:
-        """Search around ``box`` (taken as the subject's) from the next frame on, keeping the template."""
-        x, y, w, h = (float(v) for v in box)
-        self._center = np.array([x + w / 2, y + h / 2])
-        self._size = np.array([max(w, 1.0), max(h, 1.0)]) / self._calibration
-        self._velocity = np.zeros(2)
 
     @property
     def size_calibration(self) -> np.ndarray:

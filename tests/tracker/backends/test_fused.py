@@ -75,16 +75,6 @@ def test_nanotracks_box_stands_where_vittrack_is_unsure(wide_vit):
     assert box == pytest.approx(own) and score == pytest.approx(own_score)
 
 
-def test_following_the_fused_box_moves_nanotracks_search(wide_vit):
-    """With ``follow_fused`` NanoTrack's next search starts from the (wider) fused box: its next box
-    is wider than that of a NanoTrack left on its own."""
-    follows, own = _fused(wide_vit, follow_fused=True), _fused(wide_vit, follow_fused=False)
-    for backend in (follows, own):
-        backend.init(_frame(200, 150), (200.0, 150.0, SIDE, SIDE))
-        backend.update(_frame(204, 150))
-    assert follows._primary.update(_frame(204, 150))[0][2] > 1.2 * own._primary.update(_frame(204, 150))[0][2]
-
-
 def test_nanovit_made_by_name_reports_a_subject_that_leaves_lost(models):
     subject = make_tracker("nanovit", models)
     subject.init(_frame(200, 150), (200.0, 150.0, SIDE, SIDE), 0.0)
