@@ -9,9 +9,9 @@ from typing import Protocol
 import cv2
 import numpy as np
 
-from tracker.backends.fused import FusedBackend
 from tracker.backends.dcf import DcfBackend
 from tracker.backends.fear import FearBackend
+from tracker.backends.fused import FusedBackend
 from tracker.backends.nanotrack import (NANOVIT_PARAMS, V3_PARAMS, NanoTrackBackend, OrtNanoNetworks,
                                         load_nanotrack_networks, nanotrack_model_files)
 from tracker.backends.onnx_sessions import DEFAULT_THREADS
