@@ -24,7 +24,7 @@ from tracker.evaluation.data_paths import shared_data_dir, shared_sequences
 from tracker.evaluation.datasets import Sequence, load_sequence
 from tracker.runtime.boxes import Box
 from tracker.runtime.estimate import TargetEstimate, TrackState
-from tracker.runtime.registry import EMBEDDED_TRACKER, make_tracker
+from tracker.runtime.registry import EMBEDDED_MODELS, EMBEDDED_TRACKERS, make_tracker
 
 BASELINE = "opencv-csrt"
 ONNX_MODELS = ("nanotrack3", "vittrack", "fear")  # each runs plain and inside the subject tracker
@@ -55,7 +55,9 @@ def contenders(model_dir: Path | None) -> dict[str, object]:
     table["gimbaltrack csrt-fast"] = lambda: make_tracker("csrt-fast")
     table["dcf backend alone"] = lambda: BareBackend(make_backend("dcf"))
     table["gimbaltrack dcf (no models)"] = lambda: make_tracker("dcf")
-    table[f"gimbaltrack {EMBEDDED_TRACKER} (embedded model files)"] = lambda: make_tracker(EMBEDDED_TRACKER)
+    for name in EMBEDDED_TRACKERS:
+        table[f"gimbaltrack {name} (embedded model files)"] = lambda name=name: make_tracker(name)
+    table[PLAIN.format("nanovit")] = lambda: BareBackend(make_backend("nanovit", EMBEDDED_MODELS))
     if model_dir is not None:
         table["opencv-nano"] = lambda: BareBackend(make_backend("nano", model_dir))
         table["nanotrack backend alone"] = lambda: BareBackend(make_backend("nanotrack", model_dir))

@@ -20,10 +20,11 @@ def without_onnxruntime(*args: str) -> subprocess.CompletedProcess:
                           timeout=120, env=subprocess_env(), cwd=ROOT)
 
 
-@pytest.mark.parametrize("tracker", ["nanotrack3", "vittrack", "fear"])
+@pytest.mark.parametrize("tracker", ["nanotrack3", "nanovit", "vittrack", "fear"])
 def test_eval_names_the_missing_runtime_in_one_line(tmp_path: Path, tracker: str) -> None:
     sequence = write_otb(tmp_path / "seq", frames=3)
-    model_dir = [] if tracker == "nanotrack3" else ["--model-dir", str(fake_onnx.onnx_model_files(tmp_path / "models"))]
+    shipped = tracker in ("nanotrack3", "nanovit")
+    model_dir = [] if shipped else ["--model-dir", str(fake_onnx.onnx_model_files(tmp_path / "models"))]
     done = without_onnxruntime("eval", str(sequence), "--tracker", tracker, *model_dir)
     lines = done.stderr.strip().splitlines()
     assert done.returncode == 2 and len(lines) == 1, done.stderr

@@ -11,8 +11,9 @@ import numpy as np
 
 from tracker.backends.dcf import DcfBackend
 from tracker.backends.fear import FearBackend
-from tracker.backends.nanotrack import (V3_PARAMS, NanoTrackBackend, OrtNanoNetworks, load_nanotrack_networks,
-                               nanotrack_model_files)
+from tracker.backends.fused import FusedBackend
+from tracker.backends.nanotrack import (NANOVIT_PARAMS, V3_PARAMS, NanoTrackBackend, OrtNanoNetworks,
+                                        load_nanotrack_networks, nanotrack_model_files)
 from tracker.backends.onnx_sessions import DEFAULT_THREADS
 from tracker.backends.vittrack import VitTrackBackend
 from tracker.runtime.boxes import Box, cut_to_frame
@@ -132,10 +133,10 @@ def _nano(model_dir: str | Path | None) -> Callable[[], cv2.Tracker]:
 _NANO_PROBE_BOX = 32  # side of the box the model-file check starts TrackerNano on, pixels
 
 
-BACKEND_NAMES = ("dcf", "nanotrack", "nanotrack3", "vittrack", "fear", "csrt-fast", "csrt", "kcf", "mil", "mosse",
-                 "nano")
-# Backends that need model files (``model_dir``); the last three run on onnxruntime.
-MODEL_BACKENDS = ("nanotrack", "nano", "nanotrack3", "vittrack", "fear")
+BACKEND_NAMES = ("dcf", "nanotrack", "nanotrack3", "nanovit", "vittrack", "fear", "csrt-fast", "csrt", "kcf", "mil",
+                 "mosse", "nano")
+# Backends that need model files (``model_dir``); the last four run on onnxruntime.
+MODEL_BACKENDS = ("nanotrack", "nano", "nanotrack3", "nanovit", "vittrack", "fear")
 # OpenCV's KCF and Nano fail on grey frames; the others take grey as it is (cheaper than three channels).
 NEEDS_BGR = ("kcf", "nano")
 
@@ -154,6 +155,9 @@ def _bare_backend(name: str, model_dir: str | Path | None, threads: int) -> Trac
         return NanoTrackBackend(model_dir)
     if name == "nanotrack3":
         return NanoTrackBackend(model_dir, V3_PARAMS, OrtNanoNetworks(model_dir, threads), name)
+    if name == "nanovit":
+        nano = NanoTrackBackend(model_dir, NANOVIT_PARAMS, OrtNanoNetworks(model_dir, threads), "nanotrack3")
+        return FusedBackend(nano, VitTrackBackend(model_dir, threads=threads), name=name)
     if name == "vittrack":
         return VitTrackBackend(model_dir, threads=threads)
     if name == "fear":

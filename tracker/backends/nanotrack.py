@@ -16,7 +16,7 @@ subject tracker restarts the backend on a template match, ``likeness`` scores th
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
@@ -72,6 +72,9 @@ class NanoTrackParams:
 #: calibration, which were tuned on five clips for v2.
 V3_PARAMS = NanoTrackParams(window_influence=0.455, penalty_k=0.138, size_lr=0.348, velocity_gain=0.0,
                             calibration_strength=0.0)
+#: NanoTrack v3 inside ``nanovit``: half the last frame's motion ahead and a weaker cosine window, chosen
+#: on the mean over all 19 shared sequences with VitTrack's box averaged in (docs/tracker-lab.md).
+NANOVIT_PARAMS = replace(V3_PARAMS, window_influence=0.40, velocity_gain=0.5)
 
 
 def nanotrack_model_files(model_dir: str | Path | None, version: str = "v2") -> tuple[Path, Path]:

@@ -111,6 +111,12 @@ class VitTrackBackend:
         self._size = np.clip([w, h], MIN_SIZE, frame_size)
         return from_center(*(float(v) for v in self._center), *(float(v) for v in self._size)), score
 
+    def relocate(self, box: Box) -> None:
+        """Search around ``box`` (taken as the subject's) from the next frame on, keeping the template."""
+        x, y, w, h = (float(v) for v in box)
+        self._center = np.array([x + w / 2, y + h / 2])
+        self._size = np.array([max(w, 1.0), max(h, 1.0)])
+
     def likeness(self, frame: np.ndarray, box: Box) -> float:
         """The windowed confidence of a search centred on ``box`` (at its size) over the subject's
         typical confidence (1 while that is unknown); one network pass."""

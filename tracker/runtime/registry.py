@@ -20,6 +20,8 @@ FALLBACK_BACKEND = "dcf"
 DEFAULT_WITH_MODELS = "nanotrack"  # the default when the model folder holds NanoTrack v2's files
 #: The model tracker whose files ship inside the package, so that it needs no model folder.
 EMBEDDED_TRACKER = "nanotrack3"
+#: Every model tracker that runs on the shipped files alone (``nanovit``: NanoTrack v3's and VitTrack's).
+EMBEDDED_TRACKERS = (EMBEDDED_TRACKER, "nanovit")
 EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # The template refinement corrects CSRT's drift; the correlation filter's own peak is finer. The
 # template search may restart dcf only once the subject is lost: dcf keeps following through a few
@@ -32,15 +34,17 @@ EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # (size_pixel), and takes a returning subject back at its size (return_size_ratio, search_scales; a
 # weaker template match is enough where its deep likeness is strong) (docs/tracker-lab.md, "Lost-state
 # reporting for nanotrack3").
+_NANOTRACK3 = TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85, size_pixel=0.6,
+                              return_size_ratio=0.85, search_scales=(0.8, 1.0, 1.25),
+                              reacquire_score=0.6, reacquire_deep_likeness=1.0)
 _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1),
-             "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85, size_pixel=0.6,
-                                           return_size_ratio=0.85, search_scales=(0.8, 1.0, 1.25),
-                                           reacquire_score=0.6, reacquire_deep_likeness=1.0)}
+             "nanotrack3": _NANOTRACK3,
+             "nanovit": _NANOTRACK3}  # its score and deep likeness are NanoTrack v3's
 
 
 def available_trackers() -> list[str]:
     """Names ``make_tracker`` accepts; those in ``MODEL_BACKENDS`` read model files (``nanotrack3``'s
-    ship with the package)."""
+    and ``nanovit``'s ship with the package)."""
     return ["default", *BACKEND_NAMES]
 
 
@@ -50,9 +54,9 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
     ``threads``: onnxruntime's intra-op threads for the models that run on it.
 
     ``default`` is NanoTrack (v2) when ``model_dir`` holds its files, else ``DEFAULT_BACKEND`` on the
-    shipped files (or on ``model_dir``'s NanoTrack v3 files), or ``FALLBACK_BACKEND`` with a
+    shipped files (or on ``model_dir``'s files), or ``FALLBACK_BACKEND`` with a
     ``TrackerFallbackWarning`` where that model cannot be loaded.
-    ``EMBEDDED_TRACKER`` reads the files shipped with the package where ``model_dir`` is not given;
+    ``EMBEDDED_TRACKERS`` read the files shipped with the package where ``model_dir`` is not given;
     other model trackers need it. Unknown names raise ``ValueError``; missing model files, or a
     ``model_dir`` that is no folder, raise ``FileNotFoundError``; a damaged one ``ValueError``.
     """
@@ -63,7 +67,7 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
         name = DEFAULT_WITH_MODELS
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
-    if model_dir is None and name == EMBEDDED_TRACKER:
+    if model_dir is None and name in EMBEDDED_TRACKERS:
         model_dir = EMBEDDED_MODELS
     backend = make_backend(name, model_dir, threads)  # missing model files fail here, not on init()
     model = str(model_dir) if name in MODEL_BACKENDS else None

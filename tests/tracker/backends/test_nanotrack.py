@@ -215,7 +215,7 @@ FEAR_COLLAPSES = pytest.mark.xfail(strict=True, reason=(
     "likeness (0.34) over its gate; a per-frame template-feature likeness did not separate them"))
 
 
-@pytest.mark.parametrize("name", ["nanotrack", "nanotrack3", "vittrack", pytest.param("fear", marks=FEAR_COLLAPSES)])
+@pytest.mark.parametrize("name", ["nanotrack", "nanotrack3", "nanovit", "vittrack", pytest.param("fear", marks=FEAR_COLLAPSES)])
 def test_a_hidden_subject_is_not_reported_on_a_lookalike(shared_data, name):
     """NanoTrack's foreground score stays near 1 on background; the deep-feature likeness makes the
     subject tracker say ``searching`` and then ``lost`` instead of ``tracking`` on a look-alike. Every

@@ -97,3 +97,11 @@ def test_a_folder_without_models_still_gives_the_defaults(tmp_path: Path) -> Non
     # issue #23: the default's model ships with the package, so an empty folder leaves it on those files
     assert make_tracker("default", model_dir=tmp_path).name == DEFAULT_BACKEND
     assert type(make_detector("face", model_dir=tmp_path)).__name__ == "HaarFaceDetector"
+
+
+def test_nanovit_runs_on_the_embedded_model_files_with_their_licences():
+    subject = make_tracker("nanovit")
+    assert subject.name == "nanovit" and subject.model == str(EMBEDDED_MODELS)
+    folder = EMBEDDED_MODELS / "vittrack"
+    assert [p.name for p in folder.glob("*.onnx")] == ["vitTracker.onnx"]
+    assert any(folder.glob("LICENSE*")) and (folder / "PROVENANCE.md").is_file()
