@@ -75,3 +75,43 @@ def _cell_index(n: int, height: int, width: int) -> np.ndarray:
     index = (np.arange(n)[:, None, None] * (gh * gw) + (np.arange(height) // CELL)[None, :, None] * gw
              + (np.arange(width) // CELL)[None, None, :]) * SIGNED_BINS
     return index.reshape(n * height, width).astype(np.int32)
+
+
+#: The eleven basic colour terms (Berlin and Kay) as sRGB prototypes; a colour's names are its soft
+#: assignment to them by distance in CIE Lab, so the subject's colours count in the filter as its
+#: gradients do (the idea of Danelljan et al.'s colour attributes, 2014; these prototypes are ours).
+COLOUR_NAME_PROTOTYPES = {
+    "black": (20, 20, 20), "white": (240, 240, 240), "grey": (128, 128, 128), "red": (200, 30, 30),
+    "green": (40, 150, 50), "blue": (30, 60, 200), "yellow": (240, 220, 40), "orange": (240, 140, 30),
+    "brown": (120, 70, 30), "pink": (240, 150, 180), "purple": (130, 50, 150),
+}
+COLOUR_NAMES = len(COLOUR_NAME_PROTOTYPES)
+_NAME_WIDTH = 20.0  # Lab units: about the distance between neighbouring prototypes' borders
+_NAME_LEVEL_BITS = 5  # 32 levels per channel: the table has 32 ** 3 rows
+
+
+def colour_name_cells(patch: np.ndarray) -> np.ndarray:
+    """Per cell, the mean colour-name probabilities of a BGR (or grey) ``uint8`` patch's pixels:
+    ``(H // CELL, W // CELL, COLOUR_NAMES)`` float32, each cell's summing to 1."""
+    level = patch.astype(np.int32) >> (8 - _NAME_LEVEL_BITS)
+    if patch.ndim == 2:
+        bins = level * ((1 << 2 * _NAME_LEVEL_BITS) + (1 << _NAME_LEVEL_BITS) + 1)
+    else:
+        bins = (level[..., 0] << 2 * _NAME_LEVEL_BITS) + (level[..., 1] << _NAME_LEVEL_BITS) + level[..., 2]
+    names = colour_name_table(1 << _NAME_LEVEL_BITS).take(bins, axis=0)
+    height, width = bins.shape
+    return cv2.resize(names, (width // CELL, height // CELL), interpolation=cv2.INTER_AREA)
+
+
+@functools.lru_cache(maxsize=4)
+def colour_name_table(bins_per_channel: int) -> np.ndarray:
+    """Colour-name probabilities ``(bins ** 3, COLOUR_NAMES)`` of every joint BGR bin's centre."""
+    levels = (np.arange(bins_per_channel) + 0.5) * (256.0 / bins_per_channel)
+    b, g, r = np.meshgrid(levels, levels, levels, indexing="ij")
+    bgr = np.stack([b, g, r], axis=-1).reshape(-1, 1, 3).astype(np.float32) / 255.0
+    lab = cv2.cvtColor(bgr, cv2.COLOR_BGR2Lab).reshape(-1, 3)
+    prototypes = np.array([rgb[::-1] for rgb in COLOUR_NAME_PROTOTYPES.values()], np.float32).reshape(-1, 1, 3)
+    centres = cv2.cvtColor(prototypes / 255.0, cv2.COLOR_BGR2Lab).reshape(-1, 3)
+    distance = np.square(lab[:, None, :] - centres[None, :, :]).sum(axis=2)
+    weights = np.exp(-(distance - distance.min(axis=1, keepdims=True)) / (2 * _NAME_WIDTH**2))
+    return (weights / weights.sum(axis=1, keepdims=True)).astype(np.float32)
