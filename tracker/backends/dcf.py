@@ -50,6 +50,7 @@ class DcfSettings:
     # tracker whose accuracy stays within the noise of learning every frame; 3 gained little more
     # speed in the loop, 5 lost accuracy (docs/tracker-lab.md).
     update_every: int = 2
+    scale_substep: bool = False  # the scale step refined between ladder samples (fDSST)
     redetect_below: float = 0.0  # a relative peak under this also searches the eight windows around (0: never)
     redetect_offset: float = 0.5  # how far those windows are, in windows
     redetect_margin: float = 1.2  # a neighbour's peak must beat this window's by this factor
@@ -163,12 +164,16 @@ class DcfBackend:
         region = self._region(frame)
         samples = self._scale_samples(region)
         spectrum = self._scale_estimator.spectrum(samples)
-        step = self._scale_estimator.best_step(spectrum)
-        if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
-            step = 0
-        self._scale *= s.scale_step**step
+        if s.scale_substep:
+            change = self._scale_estimator.refined_step(spectrum)
+            step = round(change)
+        else:
+            step = change = self._scale_estimator.best_step(spectrum)
+        if not s.min_scale <= self._scale * s.scale_step**change <= s.max_scale:
+            step = change = 0
+        self._scale *= s.scale_step**change
         if score >= s.learn_above:
-            if step != 0:
+            if change != 0:
                 region = self._region(frame)  # the window follows the new scale
                 spectrum = self._scale_estimator.spectrum(np.roll(samples, -step, axis=0))  # re-centred on it
             self._learn(region, scale_spectrum=spectrum)
