@@ -50,10 +50,6 @@ class DcfSettings:
     # tracker whose accuracy stays within the noise of learning every frame; 3 gained little more
     # speed in the loop, 5 lost accuracy (docs/tracker-lab.md).
     update_every: int = 2
-    scale_substep: bool = False  # the scale step refined between ladder samples (fDSST)
-    redetect_below: float = 0.0  # a relative peak under this also searches the eight windows around (0: never)
-    redetect_offset: float = 0.5  # how far those windows are, in windows
-    redetect_margin: float = 1.2  # a neighbour's peak must beat this window's by this factor
 
     def __post_init__(self) -> None:
         if self.update_every < 1:
@@ -102,21 +98,7 @@ class DcfBackend:
         if self._translation is None:
             raise RuntimeError(f"{self.name}: update() before init()")
         s = self.settings
-        self._center, peak = self._locate(frame, self._center)
-        if s.redetect_below > 0 and self._typical_frames > 0 and peak < s.redetect_below * self._typical_peak:
-            self._center, peak = self._redetect(frame, self._center, peak)
-        score = self._score(peak)
-        self._frames += 1
-        if self._frames % s.update_every == 0:
-            self._rescale_and_learn(frame, score)
-        w, h = self._base_size * self._scale
-        return from_center(float(self._center[0]), float(self._center[1]), float(w), float(h)), score
-
-    def _locate(self, frame: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, float]:
-        """The subject's centre found in the window around ``centre``, and the translation
-        filter's response peak there."""
-        s = self.settings
-        patch = self._window_patch(self._region(frame, centre), centre)
+        patch = self._window_patch(self._region(frame))
         response = self._translation.respond(self._features(patch))
         peak = float(response.max())
         if s.colour_weight > 0:
@@ -125,20 +107,13 @@ class DcfBackend:
         row, col = np.unravel_index(int(np.argmax(response)), response.shape)
         shift = np.array([col + _subcell(response[row, :], col), row + _subcell(response[:, col], row)])
         shift -= np.array([response.shape[1] // 2, response.shape[0] // 2])
-        return centre + shift * CELL * (self._base_window * self._scale) / np.array(self._patch_size), peak
-
-    def _redetect(self, frame: np.ndarray, centre: np.ndarray, peak: float) -> tuple[np.ndarray, float]:
-        """Where the peak is weak, the subject may have moved past the window: search the eight
-        windows around this one (``redetect_offset`` windows away) and move to the strongest peak
-        that beats this window's by ``redetect_margin``."""
-        s = self.settings
-        best, best_peak = centre, peak
-        window = self._base_window * self._scale
-        for dx, dy in _NEIGHBOURS:
-            found, other = self._locate(frame, centre + s.redetect_offset * window * np.array([dx, dy]))
-            if other > best_peak and other > s.redetect_margin * peak:
-                best, best_peak = found, other
-        return best, best_peak
+        self._center = self._center + shift * CELL * (self._base_window * self._scale) / np.array(self._patch_size)
+        score = self._score(peak)
+        self._frames += 1
+        if self._frames % s.update_every == 0:
+            self._rescale_and_learn(frame, score)
+        w, h = self._base_size * self._scale
+        return from_center(float(self._center[0]), float(self._center[1]), float(w), float(h)), score
 
     def _score(self, peak: float) -> float:
         """The peak relative to its running typical value: 1 as usual, towards 0 as it collapses.
@@ -164,16 +139,12 @@ class DcfBackend:
         region = self._region(frame)
         samples = self._scale_samples(region)
         spectrum = self._scale_estimator.spectrum(samples)
-        if s.scale_substep:
-            change = self._scale_estimator.refined_step(spectrum)
-            step = round(change)
-        else:
-            step = change = self._scale_estimator.best_step(spectrum)
-        if not s.min_scale <= self._scale * s.scale_step**change <= s.max_scale:
-            step = change = 0
-        self._scale *= s.scale_step**change
+        step = self._scale_estimator.best_step(spectrum)
+        if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
+            step = 0
+        self._scale *= s.scale_step**step
         if score >= s.learn_above:
-            if change != 0:
+            if step != 0:
                 region = self._region(frame)  # the window follows the new scale
                 spectrum = self._scale_estimator.spectrum(np.roll(samples, -step, axis=0))  # re-centred on it
             self._learn(region, scale_spectrum=spectrum)
@@ -192,27 +163,22 @@ class DcfBackend:
             scale_spectrum = self._scale_estimator.spectrum(self._scale_samples(region))
         self._scale_estimator.learn(scale_spectrum, 1.0 if restart else k * s.scale_rate)
 
-    def _region(self, frame: np.ndarray, centre: np.ndarray | None = None) -> _Region:
-        """The window around the subject (or ``centre``), cut once per position and scale; every
-        patch comes from it."""
-        centre = self._center if centre is None else centre
-        return _Region.cut(frame, centre, self._base_window * self._scale, np.array(self._patch_size))
+    def _region(self, frame: np.ndarray) -> _Region:
+        """The window around the subject, cut once per position and scale; every patch comes from it."""
+        return _Region.cut(frame, self._center, self._base_window * self._scale, np.array(self._patch_size))
 
-    def _window_patch(self, region: _Region, centre: np.ndarray | None = None) -> np.ndarray:
+    def _window_patch(self, region: _Region) -> np.ndarray:
         """The window resampled to the patch size in one bilinear warp, at under 4:1 (see ``_Region``):
         a crop then an area resize cost several times as much and scored the same (docs/tracker-lab.md), and
         averaging the region down further to keep bilinear under 2:1 scored lower on perturbed starts."""
         window = self._base_window * self._scale / region.k
-        centre = self._center if centre is None else centre
-        return resample_window(region.image, region.to_region(centre), window, self._patch_size)
+        return resample_window(region.image, region.to_region(self._center), window, self._patch_size)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
         gradients = cell_features(unit_grey(patch)[None])[0]
         if self.settings.colour_names <= 0:
             return gradients
-        names = colour_name_cells(patch)
-        if self.settings.colour_names != 1.0:
-            names *= np.float32(self.settings.colour_names)
+        names = colour_name_cells(patch) * np.float32(self.settings.colour_names)
         return np.concatenate([gradients, names], axis=2)
 
     def _scale_samples(self, region: _Region) -> np.ndarray:
@@ -230,9 +196,6 @@ class DcfBackend:
         foreground = (xs <= max(inner[0], 1.0) / 2) & (ys <= max(inner[1], 1.0) / 2)
         background = (xs > subject[0] / 2) | (ys > subject[1] / 2)
         return foreground, background
-
-
-_NEIGHBOURS = ((-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1))
 
 
 @dataclass(frozen=True)

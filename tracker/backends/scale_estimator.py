@@ -58,17 +58,6 @@ class ScaleEstimator:
         step = int(np.argmax(self._filter.respond(spectrum)))
         return step if step <= self.scales // 2 else step - self.scales
 
-    def refined_step(self, spectrum: np.ndarray) -> float:
-        """``best_step`` refined by the parabola through the response at it and its two neighbours
-        (fDSST's sub-step scale): a slow change under half a step still moves the scale."""
-        response = self._filter.respond(spectrum)
-        index = int(np.argmax(response))
-        left, mid, right = response[index - 1], response[index], response[(index + 1) % self.scales]
-        curvature = left - 2 * mid + right
-        offset = float(np.clip(0.5 * (left - right) / curvature, -0.5, 0.5)) if curvature < 0 else 0.0
-        step = index if index <= self.scales // 2 else index - self.scales
-        return step + offset
-
     def learn(self, spectrum: np.ndarray, rate: float) -> None:
         """Fold the spectrum of samples centred on the subject's size into the filter (``rate`` 1
         restarts)."""
