@@ -18,7 +18,7 @@ import numpy as np
 
 from tracker.backends.colour_model import ColourModel, box_response, colour_index
 from tracker.backends.correlation import TranslationFilter
-from tracker.backends.features import CELL, cell_features, colour_name_cells, unit_grey
+from tracker.backends.features import CELL, cell_features, unit_grey
 from tracker.backends.scale_estimator import ScaleEstimator
 from tracker.runtime.boxes import Box, center, from_center
 from tracker.runtime.crops import resample_window
@@ -34,7 +34,6 @@ class DcfSettings:
     learning_rate: float = 0.01
     colour_rate: float = 0.04
     colour_weight: float = 0.3  # share of the colour response in the blend
-    colour_names: float = 0.0  # weight of the colour-name channels beside the gradients (0: none)
     inner_padding: float = 0.2  # foreground = subject shrunk by this x mean side
     # fDSST's finer ladder (Danelljan et al., 2017): 33 samples 1.02 apart reach as far as 17 at 1.03
     # in finer steps, which scored higher over all 19 shared sequences (docs/tracker-lab.md)
@@ -175,11 +174,7 @@ class DcfBackend:
         return resample_window(region.image, region.to_region(self._center), window, self._patch_size)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
-        gradients = cell_features(unit_grey(patch)[None])[0]
-        if self.settings.colour_names <= 0:
-            return gradients
-        names = colour_name_cells(patch) * np.float32(self.settings.colour_names)
-        return np.concatenate([gradients, names], axis=2)
+        return cell_features(unit_grey(patch)[None])[0]
 
     def _scale_samples(self, region: _Region) -> np.ndarray:
         """The scale ladder's samples around the subject (see ``ScaleEstimator.samples``)."""

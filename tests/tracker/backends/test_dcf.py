@@ -11,8 +11,7 @@ from tests.tracker.scripted_backend import ScriptedBackend, follow, gives_up, on
 from tracker.backends.colour_model import ColourModel, box_response, colour_index
 from tracker.backends.correlation import ScaleFilter, TranslationFilter, gaussian_peak
 from tracker.backends.dcf import DcfBackend, DcfSettings
-from tracker.backends.features import (CELL, CHANNELS, COLOUR_NAME_PROTOTYPES, COLOUR_NAMES, SIGNED_BINS, cell_features,
-                                     colour_name_cells)
+from tracker.backends.features import CELL, CHANNELS, SIGNED_BINS, cell_features
 from tracker.evaluation.synthetic import render_sequence, texture
 from tracker.runtime.boxes import center, iou
 from tracker.runtime.estimate import TrackState
@@ -311,40 +310,3 @@ def test_an_unsure_dcf_is_not_restarted_until_the_subject_is_lost() -> None:
     states = [e.state for e in estimates]
     assert states[GIVES_UP_AT - 1:restart - 1] == [TrackState.SEARCHING] * lost_after
     assert states[restart - 1] is TrackState.TRACKING
-
-
-@pytest.mark.parametrize(("bgr", "name"), [((30, 30, 210), "red"), ((50, 160, 40), "green"), ((210, 60, 30), "blue"),
-                                           ((40, 220, 240), "yellow"), ((245, 245, 245), "white"), ((10, 10, 10), "black")])
-def test_a_plain_colour_is_named_and_each_cell_sums_to_one(bgr: tuple[int, int, int], name: str) -> None:
-    names = colour_name_cells(np.full((8, 12, 3), bgr, np.uint8))
-    assert names.shape == (2, 3, COLOUR_NAMES)
-    np.testing.assert_allclose(names.sum(axis=2), 1.0, atol=1e-5)
-    assert list(COLOUR_NAME_PROTOTYPES)[int(np.argmax(names[0, 0]))] == name
-    assert names[0, 0].max() > 0.5
-
-
-def test_a_cell_of_two_colours_holds_each_colours_names_by_its_share() -> None:
-    patch = np.zeros((4, 4, 3), np.uint8)
-    patch[:, :1] = (30, 30, 210)  # a quarter red, the rest blue
-    patch[:, 1:] = (210, 60, 30)
-    red, blue = (colour_name_cells(np.full((4, 4, 3), c, np.uint8))[0, 0] for c in ((30, 30, 210), (210, 60, 30)))
-    np.testing.assert_allclose(colour_name_cells(patch)[0, 0], 0.25 * red + 0.75 * blue, atol=1e-5)
-
-
-def test_a_grey_patch_has_only_achromatic_names() -> None:
-    names = colour_name_cells(np.tile(np.linspace(0, 255, 16).astype(np.uint8), (4, 1)))[0]
-    chromatic = [i for i, n in enumerate(COLOUR_NAME_PROTOTYPES) if n not in ("black", "grey", "white")]
-    assert names[:, chromatic].max() < 0.2
-    assert list(COLOUR_NAME_PROTOTYPES)[int(np.argmax(names[0]))] == "black"
-    assert list(COLOUR_NAME_PROTOTYPES)[int(np.argmax(names[-1]))] == "white"
-
-
-@pytest.mark.parametrize("weight", [0.0, 0.5])
-def test_colour_names_add_their_channels_to_the_filters_features(weight: float) -> None:
-    seq = render_sequence(frames=20, target=40, speed=2.0, seed=5)
-    backend = DcfBackend(DcfSettings(colour_names=weight))
-    backend.init(seq.frames[0], seq.boxes[0])
-    features = backend._features(seq.frames[0][:40, :40])
-    assert features.shape[2] == CHANNELS + (COLOUR_NAMES if weight else 0)
-    for frame, truth in zip(seq.frames[1:], seq.boxes[1:]):
-        assert iou(backend.update(frame)[0], truth) > 0.8
