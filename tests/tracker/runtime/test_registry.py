@@ -6,14 +6,17 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tests import fake_onnx
 from tests.support import cli_command
+from tests.tracker.scripted_backend import ScriptedBackend
 from tests.tracker.evaluation.test_eval_cli import write_otb
 from tracker.detectors import make_detector
 from tracker.runtime import registry
 from tracker.runtime.registry import DEFAULT_BACKEND, EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
+from tracker.runtime.estimate import TrackState
 
 
 # NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir. The
@@ -84,3 +87,19 @@ def test_a_folder_without_models_still_gives_the_defaults(tmp_path: Path) -> Non
     # issue #23: the default's model ships with the package, so an empty folder leaves it on those files
     assert make_tracker("default", model_dir=tmp_path).name == DEFAULT_BACKEND
     assert type(make_detector("face", model_dir=tmp_path)).__name__ == "HaarFaceDetector"
+
+
+# ``dcf``'s confidence is its own score: the subject tracker's pixel likeness does not count (a
+# subject whose pixels match its first look at ~0.17 while the filter is sure stays ``tracking``;
+# with the likeness counted it was doubted). docs/tracker-lab.md, V26.
+def test_dcf_stays_sure_of_a_subject_whose_pixels_changed_while_its_filter_is_sure():
+    rng = np.random.default_rng(1)
+    first = rng.integers(0, 255, (240, 320, 3), dtype=np.uint8)
+    box = (100.0, 80.0, 40.0, 40.0)
+    changed = first.copy()
+    subject = first[80:120, 100:140].astype(float)
+    changed[80:120, 100:140] = (0.1 * subject + 0.9 * np.rot90(subject)).astype(np.uint8)  # likeness ~0.17
+    tracker = make_tracker("dcf")
+    tracker._backend = ScriptedBackend(lambda n, restarts: (box, 0.9))
+    tracker.init(first, box, 0.0)
+    assert [tracker.update(changed, i / 30).state for i in range(1, 6)] == [TrackState.TRACKING] * 5
