@@ -20,14 +20,15 @@ EMBEDDED_TRACKER = "nanotrack3"
 EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # The template refinement corrects CSRT's drift; the correlation filter's own peak is finer. The
 # template search may restart dcf only once the subject is lost: dcf keeps following through a few
-# unsure frames, and restarting it there put it on look-alike background (docs/tracker-lab.md). Its
-# own relative peak alone is its confidence: counting the pixel likeness too doubted a subject the
-# filter still held (lower over eight starts on the 19 shared sequences; docs/tracker-lab.md, V26).
+# unsure frames, and restarting it there put it on look-alike background (docs/tracker-lab.md). The
+# pixel likeness counts by its square root in its confidence: in full it doubted a subject the filter
+# still held (lower over eight starts on the 19 shared sequences), not at all kept an occluder
+# `tracking` (docs/tracker-lab.md, V25-V26).
 # NanoTrack v3's score (foreground x deep likeness) alone decides its confidence, under a lower
 # gate: the pixel likeness sank on turning subjects and pulled a subject the network still held
 # under the gate (docs/tracker-lab.md, "How the default was chosen").
 _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1,
-                                    pixel_weight=0.0),
+                                    pixel_weight=0.5),
              "nanotrack3": TrackerSettings(track_confidence=0.1, pixel_weight=0.0)}
 
 

@@ -89,9 +89,9 @@ def test_a_folder_without_models_still_gives_the_defaults(tmp_path: Path) -> Non
     assert type(make_detector("face", model_dir=tmp_path)).__name__ == "HaarFaceDetector"
 
 
-# ``dcf``'s confidence is its own score: the subject tracker's pixel likeness does not count (a
-# subject whose pixels match its first look at ~0.17 while the filter is sure stays ``tracking``;
-# with the likeness counted it was doubted). docs/tracker-lab.md, V26.
+# ``dcf``'s confidence leans on its own score: the subject tracker's pixel likeness counts by its
+# square root (a subject whose pixels match its first look at ~0.17 while the filter is sure stays
+# ``tracking``; with the likeness counted in full it was doubted). docs/tracker-lab.md, V25.
 def test_dcf_stays_sure_of_a_subject_whose_pixels_changed_while_its_filter_is_sure():
     rng = np.random.default_rng(1)
     first = rng.integers(0, 255, (240, 320, 3), dtype=np.uint8)
