@@ -15,7 +15,8 @@ console's cost in CPU, which on an idle 2-core machine is what would take fps fr
 its ``X-Capture-Time`` (the frame's time on the machine's monotonic clock) to the moment the whole
 part has been read by the viewer (``time.monotonic()`` in this process: the same clock). With
 ``--realtime`` the clip plays at its own 30 fps instead, as a camera would deliver it. Targets:
-B's fps >= 90 % of A's; capture -> frame in the viewer p50 <= 100 ms.
+B's fps >= 90 % of A's; capture -> frame in the viewer p50 <= 100 ms. The load average at the
+start and the end is printed with the figures: they are only comparable at a similar load.
 
     .venv/bin/python benchmarks/bench_console.py [--loops 3] [--rounds 3] [--realtime]
 """
@@ -141,6 +142,7 @@ def main() -> None:
     args = parser.parse_args()
     if args.loops < 1 or args.rounds < 1:
         parser.error("--loops and --rounds must be at least 1")
+    load_before = os.getloadavg()
     with tempfile.TemporaryDirectory(prefix="bench_console_") as tmp:
         folder = Path(tmp)
         clip, roi, origin = make_clip(folder, args.loops, "h264")
@@ -157,6 +159,8 @@ def main() -> None:
                   f"with console + 1 viewer {fps[True][-1]:.1f} fps ({cpu[True][-1]:.1f} CPU ms/frame), "
                   f"fps ratio {fps[True][-1] / fps[False][-1]:.2f}, {len(seen)} parts viewed", flush=True)
         print(describe_machine())
+        print("load average (1, 5, 15 min) at the start {:.1f} {:.1f} {:.1f}, at the end {:.1f} {:.1f} {:.1f}"
+              .format(*load_before, *os.getloadavg()))
         print(f"clip: {origin}, 1280x720 h264, subject {roi}, {'--realtime' if args.realtime else 'file speed'}, "
               f"{args.rounds} rounds")
         ratios = np.array(fps[True]) / np.array(fps[False])

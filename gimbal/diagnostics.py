@@ -4,8 +4,9 @@ we can drive, and does nobody else drive it?
 Each check is bounded in time and ends in a ``Check`` (passed or not, what was seen, and on failure
 a hint naming the likely cause on a real rig). ``BusCensus`` is a ``can.Listener`` on the client's
 Notifier that counts every frame by what it is: the gimbal's packets, foreign frames (DJI's own
-accessory traffic), error frames, and frames on our transmit id that we did not send (another
-host: a controller if it sends commands that move the gimbal). No CLI here:
+accessory traffic), error frames, and frames on our transmit id that we did not send. What those
+frames carry is judged by the client's own ``OtherHosts`` (the view ``track`` refuses to take
+control on): another host is a controller if it sends commands that move the gimbal. No CLI here:
 ``pipelines.cli.doctor_cmd`` prints the results.
 """
 from __future__ import annotations
@@ -24,12 +25,11 @@ import can
 from gimbal.client import GimbalClient, position_message
 from gimbal.errors import GimbalError, GimbalTimeoutError, ReturnCodeError
 from gimbal.framer import Dropped, PacketFramer
-from gimbal.messages import decode_message, is_device_push, reply_key
+from gimbal.messages import is_device_push, reply_key
 from gimbal.messages.firmware import LEGACY_ORDER_DOCUMENT, LEGACY_ORDER_YPR
 from gimbal.messages.limits import ANGLE_RANGES, TENTHS
 from gimbal.messages.motion import ANGLES_ATTITUDE, AxisDegrees, GetAngles
 from gimbal.messages.telemetry import ParameterPush
-from gimbal.other_hosts import CONTROL_COMMANDS, UNDECODED
 from gimbal.packet import Packet
 from gimbal.transport import DEFAULT_BITRATE, HOST_RX_ID, HOST_TX_ID
 
@@ -92,7 +92,6 @@ class BusCensus(can.Listener):
         self.foreign_ids: Counter[int] = Counter()
         self.packets_on: Counter[int] = Counter()  # DJI R SDK packets seen on other ids
         self.damaged: Counter[str] = Counter()  # the gimbal's bytes dropped, by reason
-        self.other_host_commands: Counter[str] = Counter()  # another host's packets on our tx id, by name
         self._framers: dict[int, PacketFramer] = {}
         self._lock = threading.Lock()
 
@@ -101,11 +100,10 @@ class BusCensus(can.Listener):
         with self._lock:
             return Counter(self.counts)
 
-    def tables(self) -> tuple[Counter[int], Counter[int], Counter[str], Counter[str]]:
-        """Copies of ``foreign_ids``, ``packets_on``, ``damaged`` and ``other_host_commands``."""
+    def tables(self) -> tuple[Counter[int], Counter[int], Counter[str]]:
+        """Copies of ``foreign_ids``, ``packets_on`` and ``damaged``."""
         with self._lock:
-            return (Counter(self.foreign_ids), Counter(self.packets_on), Counter(self.damaged),
-                    Counter(self.other_host_commands))
+            return Counter(self.foreign_ids), Counter(self.packets_on), Counter(self.damaged)
 
     def on_message_received(self, msg: can.Message) -> None:
         with self._lock:
@@ -123,8 +121,7 @@ class BusCensus(can.Listener):
             self.foreign_ids[msg.arbitration_id] += 1
             return
         if msg.arbitration_id == self.tx_id:
-            self.counts["other_host_frames"] += 1
-            self._feed(msg, self._other_host_packet)
+            self.counts["other_host_frames"] += 1  # their packets: the client's ``other_hosts``
         elif msg.arbitration_id == self.rx_id:
             self.counts["gimbal_frames"] += 1
             self._feed(msg, self._gimbal_packet)
@@ -151,19 +148,6 @@ class BusCensus(can.Listener):
                 self.counts["legacy_replies" if reply_key(packet) is None else "latest_replies"] += 1
             except GimbalError:
                 self.counts["short_replies"] += 1
-
-    def _other_host_packet(self, packet: Packet) -> None:
-        if packet.is_reply:
-            return  # a gimbal answering on the host's id is no controller
-        self.counts["other_host_packets"] += 1
-        try:
-            message = decode_message(packet)
-        except GimbalError:
-            self.other_host_commands[UNDECODED] += 1
-            return
-        self.other_host_commands[message.NAME] += 1
-        if isinstance(message, CONTROL_COMMANDS):
-            self.counts["other_host_control"] += 1
 
 
 def _hex(can_id: int) -> str:
@@ -362,12 +346,10 @@ class Doctor:
     def other_controller(self) -> Check:
         """Red when another host sends commands that move the gimbal or take it over; its queries
         (a monitoring tool's) are only reported."""
-        counts = self.census.snapshot()
-        frames, packets, control = (counts["other_host_frames"], counts["other_host_packets"],
-                                    counts["other_host_control"])
-        commands = self.census.tables()[3]
-        names = ", ".join(f"{n} {name}" for name, n in commands.most_common())
-        data = {"frames": frames, "packets": packets, "control": control, "commands": dict(commands)}
+        frames = self.census.snapshot()["other_host_frames"]
+        seen = self.client.other_hosts.seen()
+        packets, control, names = seen.commands, seen.control, seen.describe()
+        data = {"frames": frames, "packets": packets, "control": control, "commands": dict(seen.names)}
         if control:
             return Check("controller", False, f"{packets} DJI R SDK commands ({names or 'none whole'}; "
                          f"{frames} frames) on {_hex(self.rig.tx_id)} that this run did not send",

@@ -290,8 +290,9 @@ class GimbalSession:
         waiter = self.submit(message)
         try:
             while not waiter.wait(max(0.0, min(STOP_RESEND_S, until - time.monotonic()))):
-                if time.monotonic() >= until:
-                    raise GimbalTimeoutError(f"{message.NAME}: no reply within {(until - started) * 1000:.0f} ms "
+                now = time.monotonic()
+                if now >= until:
+                    raise GimbalTimeoutError(f"{message.NAME}: no reply within {(now - started) * 1000:.0f} ms "
                                              f"(sent every {STOP_RESEND_S * 1000:.0f} ms)")
                 self.stats["stop_resends"] += 1
                 self.replies.expect(waiter)

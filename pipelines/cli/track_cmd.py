@@ -59,9 +59,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "  their reports in the order given; the exit status is the worst of theirs\n"
         "exit status: 0 done; 3 done, but the gimbal link was degraded (replies missing, the gimbal\n"
         "  released for silence) or another controller was seen; 4 another controller drives the gimbal\n"
-        "  (nothing taken over; --shared-bus to run anyway); 1 the bus, source or an output failed\n"
-        "  mid-run; 2 bad input; 130 Ctrl-C; 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT (the gimbal is told to\n"
-        "  stop in every case)",
+        "  (nothing taken over; --shared-bus to run anyway); 1 the gimbal did not answer at start, or the\n"
+        "  bus, source or an output failed mid-run; 2 bad input; 130 Ctrl-C; 143 SIGTERM, 129 SIGHUP,\n"
+        "  131 SIGQUIT (the gimbal is told to stop in every case)",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("source", nargs="+", metavar="SOURCE", help="video file, image folder, camera index "
                         "(e.g. 0) or stream URL (udp://, rtsp://, http://); several: see below")

@@ -210,6 +210,25 @@ def test_another_hosts_queries_are_reported_but_pass() -> None:
     assert "no control commands" in checks["controller"].summary
 
 
+def test_the_controller_check_is_the_clients_own_view_of_other_hosts() -> None:
+    """#27: the doctor judges another host by the client's ``OtherHosts``, the view on which
+    ``track`` refuses to take control, not by a count of its own that could disagree with it."""
+    channel = f"doctor-view-{time.monotonic_ns()}"
+    sim = SimulatedGimbal(can.Bus(interface="virtual", channel=channel), DEFAULT_CONFIG, shutdown_bus=True).start()
+    host = can.Bus(interface="virtual", channel=channel)
+    census = BusCensus()
+    try:
+        with GimbalClient(host, listeners=[census]) as client:
+            doctor = Doctor(client, census, DEFAULT_RIG)
+            assert doctor.other_controller().ok
+            client.other_hosts.on_packet(message_packet(SpeedControl(0, 0, 0, SPEED_RELEASE), FIRST_SEQ), 0.0)
+            check = doctor.other_controller()
+    finally:
+        sim.stop()
+        host.shutdown()
+    assert not check.ok and check.data["commands"] == {"speed_control": 1} and check.data["control"] == 1
+
+
 def test_our_own_frames_are_not_another_controller_on_a_loopback_bus() -> None:
     census = BusCensus()
     sent = can.Message(arbitration_id=0x223, data=b"\x55", is_extended_id=False, is_rx=False)

@@ -71,3 +71,19 @@ def drag(driver, element, start: tuple[float, float], end: tuple[float, float]) 
     ActionChains(driver).move_to_element_with_offset(element, x0, y0).click_and_hold() \
         .move_by_offset(round((end[0] - start[0]) / 2), round((end[1] - start[1]) / 2)) \
         .move_by_offset(round((end[0] - start[0]) / 2), round((end[1] - start[1]) / 2)).release().perform()
+
+
+def touch_drag(driver, element, start: tuple[float, float], end: tuple[float, float]) -> None:
+    """A finger (a touch pointer, as a phone's) pressed at ``start``, moved to ``end`` and lifted;
+    ``start == end`` is a tap. CSS pixels from the element's top left."""
+    from selenium.webdriver.common.actions import interaction
+    from selenium.webdriver.common.actions.action_builder import ActionBuilder
+    from selenium.webdriver.common.actions.pointer_input import PointerInput
+
+    rect = element.rect
+    centre = (rect["width"] / 2, rect["height"] / 2)
+    at = [(round(x - centre[0]), round(y - centre[1])) for x, y in (start, end)]
+    actions = ActionBuilder(driver, mouse=PointerInput(interaction.POINTER_TOUCH, "finger"))
+    actions.pointer_action.move_to(element, *at[0]).pointer_down().pause(0.05) \
+        .move_to(element, *at[1]).pointer_up()
+    actions.perform()

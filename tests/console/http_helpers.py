@@ -45,9 +45,12 @@ class MjpegReader:
         self.status = self.response.status
 
     def part(self) -> tuple[dict[str, str], bytes]:
+        """The next part; EOFError once the server has ended the stream."""
         line = self.response.readline()
-        while line.strip() == b"":
+        while line in (b"\r\n", b"\n"):
             line = self.response.readline()
+        if not line:
+            raise EOFError("the stream ended")
         assert line.strip() == b"--frame", line
         headers = {}
         while (line := self.response.readline().strip()):

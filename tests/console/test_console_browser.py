@@ -11,7 +11,6 @@ import shutil
 import time
 from pathlib import Path
 
-from selenium.webdriver.common.by import By
 
 from gimbal.client import SPEED_RELEASE
 from gimbal.messages.camera import CameraActionCode
@@ -33,8 +32,8 @@ def test_watch_pick_record_and_pause_from_the_browser(tmp_path: Path) -> None:
     try:
         with chromium(tmp_path / "profile") as driver:
             driver.get(run.url)
-            view = driver.find_element(By.ID, "stream")
-            status = driver.find_element(By.ID, "status")
+            view = driver.find_element("id", "stream")
+            status = driver.find_element("id", "status")
             assert wait_until(lambda: driver.execute_script("return arguments[0].naturalWidth", view) > 0, 30)
             assert wait_until(lambda: "of " in status.text and "–" not in status.text.split("frame")[1][:4], 15)
             first = element_image(view)
@@ -42,22 +41,22 @@ def test_watch_pick_record_and_pause_from_the_browser(tmp_path: Path) -> None:
             changed = (abs(element_image(view).astype(int) - first.astype(int)).max(axis=2) > 40).mean()
             assert changed > 0.001, f"the view did not move ({changed:.3%} of its pixels changed)"
 
-            band = driver.find_element(By.ID, "band")
+            band = driver.find_element("id", "band")
             scale = band.rect["width"] / SIZE[0]
             x, y, w, h = subject_box(0, standing)
             drag(driver, band, (x * scale, y * scale), ((x + w) * scale, (y + h) * scale))
             assert wait_until(lambda: state()["state"] == "tracking", 10)
-            driver.find_element(By.ID, "record").click()
+            driver.find_element("id", "record").click()
             assert wait_until(lambda: state()["recording"]["on"] and "on" in status.text, 10)
             time.sleep(0.5)
             shot = tmp_path / "console.png"
             driver.save_screenshot(str(shot))
             if os.environ.get("GIMBALTRACK_CONSOLE_SCREENSHOT"):
                 shutil.copyfile(shot, os.environ["GIMBALTRACK_CONSOLE_SCREENSHOT"])
-            driver.find_element(By.ID, "pause").click()
+            driver.find_element("id", "pause").click()
             assert wait_until(lambda: state()["state"] == "paused" and "paused" in status.text, 10)
             driver.execute_script("window.confirm = () => true")
-            driver.find_element(By.ID, "stop").click()
+            driver.find_element("id", "stop").click()
             code, _, stderr = run.finish()
     finally:
         run.kill()

@@ -2,15 +2,18 @@
 on the bus what it says (the CAN log); stop ends the run with status 0 and its outputs."""
 from __future__ import annotations
 
+import http.client
 import json
 import threading
+import time
 from pathlib import Path
 
 from gimbal.client import SPEED_RELEASE
 from gimbal.messages.camera import CameraActionCode
+from pipelines.cli.track_cmd import EXIT_DEGRADED_LINK
 from pipelines.console.server import ConsoleServer
 from pipelines.outputs.telemetry import read_telemetry
-from tests.console.http_helpers import post, request
+from tests.console.http_helpers import MjpegReader, post, request
 from tests.console.track_run import FRAMES, ConsoleRun, drifting_slowly, subject_box
 from tests.support import wait_until
 from tests.track.helpers import (
@@ -97,6 +100,8 @@ def test_recenter_pauses_and_sends_the_gimbal_home(tmp_path: Path) -> None:
     finally:
         run.kill()
     assert code == 0, stderr
+    lines = read_telemetry(run.out / "telemetry.jsonl")
+    assert [a["action"] for line in lines for a in line.get("operator", [])] == ["recenter", "stop"]
     sent = host_commands(decoded(run.out / "can.log"))
     names = [r["name"] for r in sent]
     recenter = names.index("recenter_selfie")
@@ -109,7 +114,6 @@ def test_closing_every_view_changes_nothing_and_a_bad_request_changes_nothing(tm
     run = ConsoleRun(tmp_path)
     try:
         assert wait_until(lambda: (state(run)["frame"] or 0) >= 5, 30)
-        from tests.console.http_helpers import MjpegReader
         reader = MjpegReader(run.port)
         reader.part()
         reader.close()
@@ -167,3 +171,49 @@ def test_a_console_that_dies_stops_and_releases_the_gimbal(tmp_path: Path, monke
     assert summary["status"] == "output failed" and "console" in summary["error"]
     assert_stopped_at_end(decoded(out / "can.log"))
     assert len(read_telemetry(out / "telemetry.jsonl")) == summary["frames"] > 10
+
+
+def test_a_file_at_file_speed_runs_to_its_end_with_the_view_following(tmp_path: Path) -> None:
+    """No --realtime: the file is read as fast as the loop goes, the viewer is shown recent frames
+    all the way (not a queue behind the loop), and the run ends by itself with status 0."""
+    clip = make_clip(tmp_path / "clip.avi", FRAMES, drifting_slowly)
+    run = ConsoleRun(tmp_path, source=str(clip))
+    seen: list[tuple[int, float]] = []  # (frame index, capture -> received s)
+    reader = MjpegReader(run.port, "?fps=30&width=320")
+    try:
+        while True:
+            try:
+                headers, data = reader.part()
+            except (EOFError, OSError, http.client.HTTPException):
+                break
+            seen.append((int(headers["x-frame-index"]), time.monotonic() - float(headers["x-capture-time"])))
+        code, _, stderr = run.finish()
+    finally:
+        reader.close()
+        run.kill()
+    assert code == 0, stderr
+    summary = run.summary()
+    assert summary["status"] == "end of source" and summary["frames"] == FRAMES
+    indexes = [index for index, _ in seen]
+    assert len(indexes) >= 10 and indexes == sorted(set(indexes)), indexes
+    assert indexes[-1] >= FRAMES * 0.8, indexes  # it followed the file to (near) its end
+    lags = sorted(lag for _, lag in seen)
+    assert lags[len(lags) // 2] < 1.0, lags  # each shown when it was new, not from a backlog
+
+
+def test_the_status_shows_refusals_timeouts_and_a_silent_gimbal(tmp_path: Path) -> None:
+    """The built-in simulator refuses some commands, then falls silent: the status counts the
+    NACKs, then the reply timeouts, and says the gimbal is silent. A stop then ends the run as
+    stopped, with the degraded link's exit status like any run that lost its gimbal."""
+    run = ConsoleRun(tmp_path, "--sim-faults", "nack=0.3,silent=4:60,seed=3")
+    try:
+        assert wait_until(lambda: state(run)["bus"]["nacks"] > 0, 20), state(run)["bus"]
+        assert state(run)["bus"]["silent"] is False and state(run)["bus"]["timeouts"] == 0
+        assert wait_until(lambda: state(run)["bus"]["silent"] and state(run)["bus"]["timeouts"] > 0, 20), \
+            state(run)["bus"]
+        assert post(run.port, "/api/stop")[0] == 200
+        code, _, stderr = run.finish()
+    finally:
+        run.kill()
+    assert code == EXIT_DEGRADED_LINK, stderr
+    assert run.summary()["status"] == "stopped from the console"

@@ -10,7 +10,7 @@ import pytest
 from gimbal.client import GimbalClient
 from gimbal.errors import BusError, GimbalTimeoutError, ReturnCodeError
 from gimbal.messages import message_packet
-from gimbal.messages.motion import AnglesReply, GetAngles, SpeedControl, SpeedControlReply
+from gimbal.messages.motion import SPEED_RELEASE, AnglesReply, GetAngles, SpeedControl, SpeedControlReply
 from gimbal.messages.telemetry import ParameterPush
 from gimbal.other_hosts import OtherHosts
 from gimbal.packet import encode_packet
@@ -139,3 +139,15 @@ def test_the_final_stop_is_resent_until_answered(channel: str, peer: ScriptedPee
     assert speed_messages(peer)[1:] == [ZERO, ZERO, ZERO, RELEASE, RELEASE]
     assert client.stats["stop_resends"] == 3
     assert took < STOP_RETRY_S
+
+
+def test_a_stop_whose_time_ran_out_before_it_was_sent_says_how_long_it_waited(channel: str,
+                                                                           peer: ScriptedPeer) -> None:
+    """A zero that overran its quarter second on a loaded machine left the release no time: its
+    warning read "no reply within -2 ms"."""
+    peer.silence(SpeedControl)
+    with GimbalClient(interface="virtual", channel=channel, timeout=0.05, retries=0) as client:
+        release = SpeedControl(0, 0, 0, SPEED_RELEASE)
+        with pytest.raises(GimbalTimeoutError, match=r"no reply within \d+ ms") as raised:
+            client._stop_until_answered(release, until=time.monotonic() - 0.002)
+    assert speed_messages(peer) == [RELEASE], raised.value  # sent once all the same

@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import pytest
 
@@ -11,7 +12,7 @@ from gimbal.client import GimbalClient
 from gimbal.other_hosts import OtherHostsSeen
 from gimbal.sim import Faults, SimConfig, start_in_process
 from gimbal.watchdog import BusHealth, BusWatchdog, DEGRADED, DISENGAGED, ENGAGED
-from pipelines.loop.link import LinkNotices, link_degraded, link_health, link_report
+from pipelines.loop.link import LinkNotices, LinkSink, link_degraded, link_health, link_report
 
 
 class FakeClock:
@@ -254,6 +255,31 @@ def test_taking_the_gimbal_back_restarts_a_recording_the_camera_stopped() -> Non
     recorder.stop()
     recorder.restore()  # stopped on purpose: left stopped
     assert camera.starts == 2
+
+
+def test_the_link_sink_restores_the_record_state_once_the_gimbal_is_taken_back() -> None:
+    """The loop's sink, not only the recorder: a camera stopped while the gimbal was released is
+    started again on the frame that sees it taken back, and only then."""
+    from types import SimpleNamespace
+
+    from pipelines.loop.recording import Recorder
+
+    camera = Camera()
+    recorder = Recorder(camera, requested=True)  # type: ignore[arg-type]
+    recorder.on_acquired()
+    sink = LinkSink(LinkNotices(3.0, lambda line: None), recorder)
+    frame: Any = None  # the sink reads only the record
+
+    def record(index: int, state: BusHealth) -> Any:  # the FrameRecord fields the sink reads
+        return SimpleNamespace(bus=state, other_hosts=NOBODY, index=index)
+
+    states = [health(), health(DEGRADED, 1, unanswered=3), health(DISENGAGED, 1, 1, unanswered=80)]
+    for index, state in enumerate(states):
+        sink.on_frame(record(index, state), frame)
+    camera.recording = False  # power-cycled while released
+    assert camera.starts == 1
+    sink.on_frame(record(3, health(DEGRADED, 1, 1, unanswered=81)), frame)  # taken back
+    assert camera.starts == 2 and camera.recording and recorder.status["restarts"] == 1
 
 
 # Issue #26 against the in-process simulated gimbal with faults: the keep-alive streams through

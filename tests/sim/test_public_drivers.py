@@ -184,3 +184,16 @@ def test_the_document_example_packet_is_what_each_driver_builds() -> None:
     assert command(0x00, struct.pack("<3h2B", 32, 48, 64, 0x01, 20), seq=0x1122) == example
     assert PositionControl.decode_payload(example[14:-4]) == PositionControl(32, 48, 64, 1, 20)
     assert GetAngles.decode_payload(b"\x01") == GetAngles(1)
+
+
+# --- met in ports of these drivers: "push off" sent as 0x00 -----------------------------------
+# The document's push control (0x0E/0x07) ctrl_byte is 0x01 on, 0x02 off, 0x00 "no operation".
+
+def test_push_off_sent_as_0x00_is_a_valid_no_operation_and_the_pushes_go_on(make_sim) -> None:
+    push_on, push_off_as_zero = command(0x07, b"\x01", seq=5), command(0x07, b"\x00", seq=6)
+    records = decode(frames(push_off_as_zero))
+    assert [(r["name"], r["fields"]) for r in records] == [("push_control", {"ctrl_byte": 0x00})]
+    assert not any("error" in r or r.get("out_of_range") for r in records)
+    codes, sim = reply_codes(make_sim, frames(push_on) + frames(push_off_as_zero))
+    assert codes == [0x00, 0x00]  # both accepted
+    assert sim.state().push_enabled  # the 0x00 changed nothing: the gimbal keeps pushing

@@ -22,6 +22,7 @@ import pipelines.loop.track_session
 from gimbal.client import GimbalClient
 from gimbal.errors import ReturnCodeError
 from gimbal.sim import Faults
+from pipelines.cli import main
 from pipelines.loop.acquire import AcquiringSubject
 from pipelines.outputs.telemetry import TelemetryWriter, read_telemetry
 from tests import fake_onnx
@@ -162,6 +163,7 @@ def _wait_for(predicate, timeout: float, what: str) -> None:  # type: ignore[no-
     ([signal.SIGINT], 130, "interrupted (SIGINT)"),
     ([signal.SIGTERM], 143, "terminated (SIGTERM)"),
     ([signal.SIGHUP], 129, "terminated (SIGHUP)"),  # the terminal closed
+    ([signal.SIGQUIT], 131, "terminated (SIGQUIT)"),  # Ctrl-\ (docs/track.md's exit codes)
     ([signal.SIGINT, signal.SIGINT], 130, "interrupted (SIGINT)"),  # an impatient second Ctrl-C
 ])
 def test_signals_stop_the_gimbal_and_keep_the_outputs(tmp_path: Path, signums: list[int], code: int,
@@ -453,3 +455,16 @@ def test_a_bad_yunet_file_is_a_one_line_error(content: bytes, tmp_path: Path,
     assert err == (f"gimbaltrack track: error: YuNet face detector {model}: not a YuNet network "
                    "(damaged or another file?)\n")
     assert not out.exists()
+
+
+def test_the_help_and_docs_name_the_same_exit_statuses(capsys: pytest.CaptureFixture[str]) -> None:
+    """``track --help`` once left out that a gimbal silent at start is exit 1; docs/track.md says so."""
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    statuses = help_text.split("exit status:", 1)[1]
+    assert "1 the gimbal did not answer at start" in statuses
+    for code in (0, 1, 2, 3, 4, 129, 130, 131, 143):
+        assert f" {code} " in f" {statuses}", code
+    docs = " ".join((ROOT / "docs" / "track.md").read_text().split())
+    assert "1 the gimbal does not answer at start" in docs
