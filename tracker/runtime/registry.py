@@ -25,7 +25,10 @@ EMBEDDED_TRACKERS = (EMBEDDED_TRACKER, "nanovit")
 EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # The template refinement corrects CSRT's drift; the correlation filter's own peak is finer. The
 # template search may restart dcf only once the subject is lost: dcf keeps following through a few
-# unsure frames, and restarting it there put it on look-alike background (docs/tracker-lab.md).
+# unsure frames, and restarting it there put it on look-alike background (docs/tracker-lab.md). The
+# pixel likeness counts by its square root in its confidence: in full it doubted a subject the filter
+# still held (lower over eight starts on the 19 shared sequences), not at all kept an occluder
+# `tracking` (docs/tracker-lab.md, V25-V26).
 # NanoTrack v3's score (foreground x deep likeness) alone decides its confidence, under a lower
 # gate: the pixel likeness sank on turning subjects and pulled a subject the network still held
 # under the gate (docs/tracker-lab.md, "How the default was chosen"). Its score stays high on a cover
@@ -37,7 +40,8 @@ EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 _NANOTRACK3 = TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85, size_pixel=0.6,
                               return_size_ratio=0.85, search_scales=(0.8, 1.0, 1.25),
                               reacquire_score=0.6, reacquire_deep_likeness=1.0)
-_SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1),
+_SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1,
+                                    pixel_weight=0.5),
              "nanotrack3": _NANOTRACK3,
              "nanovit": _NANOTRACK3}  # its score and deep likeness are NanoTrack v3's
 

@@ -6,14 +6,17 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tests import fake_onnx
 from tests.support import cli_command
+from tests.tracker.scripted_backend import ScriptedBackend
 from tests.tracker.evaluation.test_eval_cli import write_otb
 from tracker.detectors import make_detector
 from tracker.runtime import registry
 from tracker.runtime.registry import DEFAULT_BACKEND, EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
+from tracker.runtime.estimate import TrackState
 
 
 # NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir, and is
@@ -105,3 +108,19 @@ def test_nanovit_runs_on_the_embedded_model_files_with_their_licences():
     folder = EMBEDDED_MODELS / "vittrack"
     assert [p.name for p in folder.glob("*.onnx")] == ["vitTracker.onnx"]
     assert any(folder.glob("LICENSE*")) and (folder / "PROVENANCE.md").is_file()
+
+
+# ``dcf``'s confidence leans on its own score: the subject tracker's pixel likeness counts by its
+# square root (a subject whose pixels match its first look at ~0.17 while the filter is sure stays
+# ``tracking``; with the likeness counted in full it was doubted). docs/tracker-lab.md, V25.
+def test_dcf_stays_sure_of_a_subject_whose_pixels_changed_while_its_filter_is_sure():
+    rng = np.random.default_rng(1)
+    first = rng.integers(0, 255, (240, 320, 3), dtype=np.uint8)
+    box = (100.0, 80.0, 40.0, 40.0)
+    changed = first.copy()
+    subject = first[80:120, 100:140].astype(float)
+    changed[80:120, 100:140] = (0.1 * subject + 0.9 * np.rot90(subject)).astype(np.uint8)  # likeness ~0.17
+    tracker = make_tracker("dcf")
+    tracker._backend = ScriptedBackend(lambda n, restarts: (box, 0.9))
+    tracker.init(first, box, 0.0)
+    assert [tracker.update(changed, i / 30).state for i in range(1, 6)] == [TrackState.TRACKING] * 5
