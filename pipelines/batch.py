@@ -27,6 +27,9 @@ ONE_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THRE
 
 #: How long stopped workers have to hand back what they were doing (a track run finishes its outputs).
 STOP_GRACE_S = 15.0
+#: How often an idle or busy worker checks that the command that started it is still there.
+PARENT_CHECK_S = 0.5
+EXIT_PARENT_GONE = 1
 
 
 class InputFailed(Exception):
@@ -184,11 +187,15 @@ def _start_worker(stop: Event, log_level: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)  # idle: a stop has nothing to cut short
     one_thread()
-    threading.Thread(target=_terminate_on_stop, args=(stop,), name="stop-watch", daemon=True).start()
+    threading.Thread(target=_terminate_on_stop, args=(stop, os.getppid()), name="stop-watch", daemon=True).start()
 
 
-def _terminate_on_stop(stop: Event) -> None:
-    stop.wait()
+def _terminate_on_stop(stop: Event, parent: int) -> None:
+    """A stop becomes a SIGTERM; a parent that died without asking (killed, SIGKILL) ends the
+    worker at once: nobody reads its result any more, and it would run, or wait to write, for ever."""
+    while not stop.wait(PARENT_CHECK_S):
+        if os.getppid() != parent:
+            os._exit(EXIT_PARENT_GONE)
     os.kill(os.getpid(), signal.SIGTERM)
 
 

@@ -116,3 +116,51 @@ def test_two_jobs_give_the_boxes_of_one_on_real_footage(shared_data):
     sequences = [load_sequence(shared_data / "sequences" / name) for name in ("otb_skiing", "uav123_car14")]
     serial, parallel = score_all(sequences, jobs=1), score_all(sequences, jobs=2)
     assert all(o.error is None for o in serial + parallel) and scores(parallel) == scores(serial)
+
+
+def test_workers_end_when_the_command_is_killed(folders, tmp_path):
+    """A SIGKILL gives the command no chance to stop its workers: they notice it has gone and end
+    within seconds instead of running (or waiting to hand back a result) for ever."""
+    slow = long_sequence(tmp_path / "slow")
+    command = cli_command("eval", str(slow), str(slow), "--tracker", "csrt", "--jobs", "2", "--json")
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        workers: list[int] = []
+        deadline = time.monotonic() + 60
+        while len(workers) < 2 and time.monotonic() < deadline:
+            time.sleep(0.2)
+            workers = [pid for pid in _children(process.pid) if _is_worker(pid)]
+        assert len(workers) == 2, "the workers never started"
+        time.sleep(2)  # both under way on their sequence
+        process.kill()
+        process.wait()
+        deadline = time.monotonic() + 10
+        while any(_running(pid) for pid in workers) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not any(_running(pid) for pid in workers)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        process.stdout.close()
+        process.stderr.close()
+
+
+def _children(pid: int) -> list[int]:
+    return [int(p) for p in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+
+
+def _is_worker(pid: int) -> bool:
+    try:
+        return "spawn_main" in Path(f"/proc/{pid}/cmdline").read_text()
+    except OSError:
+        return False
+
+
+def _running(pid: int) -> bool:
+    """Alive and not a zombie waiting to be reaped."""
+    try:
+        status = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return status.rsplit(")", 1)[1].split()[0] != "Z"
