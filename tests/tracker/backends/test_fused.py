@@ -83,3 +83,17 @@ def test_nanovit_made_by_name_reports_a_subject_that_leaves_lost(models):
     assert all(e.state is TrackState.TRACKING for e in present)
     assert TrackState.TRACKING not in {e.state for e in absent}
     assert absent[-1].state is TrackState.LOST
+
+
+def test_the_anchor_likeness_is_nanotracks_so_the_verification_holds_for_nanovit(wide_vit):
+    """The subject tracker verifies a box by the backend's ``anchor_likeness``; a fused backend
+    without one would pass every box, cover or background included."""
+    fused, alone = _fused(wide_vit), _nano(wide_vit)
+    start = (200.0, 150.0, SIDE, SIDE)
+    fused.init(_frame(200, 150), start)
+    alone.init(_frame(200, 150), start)
+    for x in (204, 208, -1, -1):
+        fused.update(_frame(x, 150))
+        alone.update(_frame(x, 150))
+        assert fused.anchor_likeness() == pytest.approx(alone.anchor_likeness())
+    assert fused.anchor_likeness() < 1.0
