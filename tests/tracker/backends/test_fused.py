@@ -9,8 +9,6 @@ from tracker.backends.fused import FusedBackend, FusionParams
 from tracker.backends.nanotrack import V3_PARAMS, NanoTrackBackend, OrtNanoNetworks
 from tracker.backends.vittrack import VitTrackBackend
 from tracker.runtime.boxes import center
-from tracker.runtime.estimate import TrackState
-from tracker.runtime.registry import make_tracker
 
 SIDE = 32
 
@@ -73,16 +71,6 @@ def test_nanotracks_box_stands_where_vittrack_is_unsure(wide_vit):
     box, score = fused.update(_frame(-1, -1))  # gone: VitTrack's confidence falls under fuse_above
     own, own_score = alone.update(_frame(-1, -1))
     assert box == pytest.approx(own) and score == pytest.approx(own_score)
-
-
-def test_nanovit_made_by_name_reports_a_subject_that_leaves_lost(models):
-    subject = make_tracker("nanovit", models)
-    subject.init(_frame(200, 150), (200.0, 150.0, SIDE, SIDE), 0.0)
-    present = [subject.update(_frame(200, 150), i / 30) for i in range(1, 10)]
-    absent = [subject.update(_frame(-1, -1), i / 30) for i in range(10, 40)]
-    assert all(e.state is TrackState.TRACKING for e in present)
-    assert TrackState.TRACKING not in {e.state for e in absent}
-    assert absent[-1].state is TrackState.LOST
 
 
 def test_the_anchor_likeness_is_nanotracks_so_the_verification_holds_for_nanovit(wide_vit):

@@ -162,9 +162,11 @@ def test_grey_and_bgra_frames_are_tracked_too(models, name):
     assert score > 0.5 and abs(center(box)[0] - 224) <= 5
 
 
-def test_nanotrack3_made_by_name_reports_a_subject_that_leaves_lost(models):
-    """As made by ``make_tracker`` (its confidence from the backend's score alone, under a lower gate)."""
-    subject = make_tracker("nanotrack3", models)
+@pytest.mark.parametrize("name", ["nanotrack3", "nanovit"])
+def test_nanotrack3_made_by_name_reports_a_subject_that_leaves_lost(models, name):
+    """As made by ``make_tracker`` (its confidence from the backend's score alone, under a lower gate;
+    ``nanovit`` shares the settings and NanoTrack's score)."""
+    subject = make_tracker(name, models)
     subject.init(_frame(200, 150), (200.0, 150.0, SIDE, SIDE), 0.0)
     present = [subject.update(_frame(200, 150), i / 30) for i in range(1, 10)]
     absent = [subject.update(_frame(-1, -1), i / 30) for i in range(10, 40)]
