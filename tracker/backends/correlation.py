@@ -84,3 +84,54 @@ class ScaleFilter:
             raise RuntimeError("ScaleFilter.respond() before learn()")
         product = np.sum(self._numerator * spectrum, axis=1) / (self._denominator + self._regularisation)
         return fft.irfft(product, n=self._scales)
+
+
+class MaskedTranslationFilter:
+    """lab: a translation filter held to the subject's support by ADMM (CSR-DCF, Lukezic et al.,
+    2017), one filter per channel, so that the window can hold more background than the filter."""
+
+    def __init__(self, shape: tuple[int, int], sigma: float, mask: np.ndarray, iterations: int = 4,
+                 mu: float = 5.0, beta: float = 3.0, mu_max: float = 20.0, regularisation: float = 0.01,
+                 channel_weights: bool = False) -> None:
+        rows, cols = shape
+        self.shape = shape
+        self._label = fft.rfft2(gaussian_peak(shape, sigma).astype(np.float32))[..., None]
+        self._window = (np.hanning(rows)[:, None] * np.hanning(cols)[None, :])[..., None].astype(np.float32)
+        self._centred = np.fft.fftshift(np.arange(rows * cols).reshape(shape))
+        # the filter's support: the mask mirrored about cell 0 (the filter is the template reversed)
+        self._mask = np.roll(mask[::-1, ::-1], 1, axis=(0, 1))[..., None].astype(np.float32)
+        self._iterations, self._mu, self._beta, self._mu_max = iterations, mu, beta, mu_max
+        self._regularisation = regularisation
+        self._filter: np.ndarray | None = None
+        self._channel_weights = channel_weights
+        self._weights: np.ndarray | None = None
+
+    def learn(self, features: np.ndarray, rate: float) -> None:
+        spectrum = fft.rfft2(features * self._window, axes=(0, 1))
+        energy = (spectrum * np.conj(spectrum)).real
+        target = self._label * np.conj(spectrum)
+        masked = fft.rfft2(self._mask * fft.irfft2(target / (energy + self._regularisation), s=self.shape, axes=(0, 1)),
+                           axes=(0, 1))
+        lagrange = np.zeros_like(masked)
+        mu = self._mu
+        size = self.shape[0] * self.shape[1]
+        for _ in range(self._iterations):
+            free = (target + mu * masked - lagrange) / (energy + mu)
+            spatial = fft.irfft2(lagrange + mu * free, s=self.shape, axes=(0, 1))
+            masked = fft.rfft2(self._mask * spatial / (self._regularisation / (2 * size) + mu), axes=(0, 1))
+            lagrange = lagrange + mu * (free - masked)
+            mu = min(self._beta * mu, self._mu_max)
+        self._filter = running_average(self._filter, masked.astype(np.complex64), rate)
+        if self._channel_weights:  # CSR-DCF's learning reliability: each channel's own peak on the sample
+            peaks = np.maximum(fft.irfft2(masked * spectrum, s=self.shape, axes=(0, 1)).max(axis=(0, 1)), 0.0)
+            weights = (peaks / max(float(peaks.sum()), 1e-9)).astype(np.float32)
+            self._weights = running_average(self._weights, weights, rate)
+
+    def respond(self, features: np.ndarray) -> np.ndarray:
+        if self._filter is None:
+            raise RuntimeError("MaskedTranslationFilter.respond() before learn()")
+        spectrum = fft.rfft2(features * self._window, axes=(0, 1))
+        product = self._filter * spectrum
+        if self._weights is not None:
+            product = product * self._weights
+        return fft.irfft2(np.sum(product, axis=2), s=self.shape).take(self._centred)
