@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from tracker.backends.colour_model import ColourModel, box_response, colour_index
-from tracker.backends.correlation import MaskedTranslationFilter, TranslationFilter
+from tracker.backends.correlation import TranslationFilter
 from tracker.backends.features import CELL, cell_features, unit_grey
 from tracker.backends.scale_estimator import ScaleEstimator
 from tracker.runtime.boxes import Box, center, from_center
@@ -32,7 +32,6 @@ class DcfSettings:
     window_area: float = 100.0**2  # the window is resized to about this many pixels (Staple: 150**2)
     sigma_factor: float = 1 / 16  # label width relative to the subject's size
     learning_rate: float = 0.01
-    regularisation: float = 1e-3
     colour_rate: float = 0.04
     colour_weight: float = 0.3  # share of the colour response in the blend
     inner_padding: float = 0.2  # foreground = subject shrunk by this x mean side
@@ -50,16 +49,6 @@ class DcfSettings:
     # tracker whose accuracy stays within the noise of learning every frame; 3 gained little more
     # speed in the loop, 5 lost accuracy (docs/tracker-lab.md).
     update_every: int = 2
-    score_by: str = "peak"  # lab: "peak", "psr" (gate and score), "psr_gate" (gate only)
-    samf_step: float = 0.0  # lab: > 0 searches the window at scale x step**{-1, 0, 1} too
-    samf_penalty: float = 0.97
-    scale_filter: bool = True
-    masked_context: float = 0.0  # lab: > 0 uses this context and the CSR-DCF masked filter
-    channel_weights: bool = False
-    slow_rate: float = 0.0  # lab: > 0 keeps a long-term filter learnt at learning_rate x this
-    slow_learn_above: float = 0.7
-    slow_below: float = 0.6
-    slow_beats: float = 1.2
 
     def __post_init__(self) -> None:
         if self.update_every < 1:
@@ -86,8 +75,7 @@ class DcfBackend:
         self._center = np.array(center(box))
         self._base_size = np.array([max(box[2], 2.0), max(box[3], 2.0)])
         self._scale = 1.0
-        context = s.masked_context if s.masked_context > 0 else s.context
-        window = self._base_size + context * self._base_size.mean()
+        window = self._base_size + s.context * self._base_size.mean()
         resize = np.sqrt(s.window_area / np.prod(window))
         grid = np.maximum(np.round(window * resize / CELL).astype(int), 4)  # cols, rows
         self._patch_size = (int(grid[0]) * CELL, int(grid[1]) * CELL)  # the window patch, px
@@ -96,23 +84,12 @@ class DcfBackend:
         subject_cells = self._base_size * cells_per_px
         self._colour_box = tuple(int(max(1, 2 * round(c / 2) + 1)) for c in subject_cells)
         sigma = np.sqrt(np.prod(subject_cells)) * s.sigma_factor
-        self._translation = TranslationFilter((int(grid[1]), int(grid[0])), sigma, s.regularisation)
-        if s.masked_context > 0:
-            rows = np.abs(np.arange(grid[1]) + 0.5 - grid[1] / 2.0)[:, None] <= max(subject_cells[1], 1.0) / 2
-            cols = np.abs(np.arange(grid[0]) + 0.5 - grid[0] / 2.0)[None, :] <= max(subject_cells[0], 1.0) / 2
-            self._translation = MaskedTranslationFilter((int(grid[1]), int(grid[0])), sigma, rows & cols,
-                                                        channel_weights=s.channel_weights)
+        self._translation = TranslationFilter((int(grid[1]), int(grid[0])), sigma)
         self._colour = ColourModel()
         self._masks = self._colour_masks(cells_per_px * CELL)
         self._scale_estimator = ScaleEstimator(tuple(self._base_size), s.scales, s.scale_step, s.scale_area)
         self._typical_peak = 0.0
         self._typical_frames = 0
-        self._typical_psr = 0.0
-        self._typical_psr_frames = 0
-        self._slow = TranslationFilter((int(grid[1]), int(grid[0])), sigma, s.regularisation)
-        self._slow_typical = 0.0
-        self._slow_frames = 0
-        self._slow_score = 1.0
         self._frames = 0
         self._learn(self._region(frame), restart=True)
 
@@ -120,83 +97,22 @@ class DcfBackend:
         if self._translation is None:
             raise RuntimeError(f"{self.name}: update() before init()")
         s = self.settings
-        update_frame = (self._frames + 1) % s.update_every == 0
-        factors = (1.0,) if s.samf_step <= 0 else (1.0, s.samf_step, 1.0 / s.samf_step)
-        region = _Region.cut(frame, self._center, self._base_window * self._scale * max(factors),
-                             np.array(self._patch_size))
-        best = None
-        for factor in factors:
-            patch = self._window_patch(region, factor)
-            features = self._features(patch)
-            response = self._translation.respond(features)
-            peak = float(response.max())
-            weighted = peak * (1.0 if factor == 1.0 else s.samf_penalty)
-            if best is None or weighted > best[0]:
-                best = (weighted, factor, patch, features, response, peak)
-        _, factor, patch, features, response, peak = best
-        if s.score_by == "peak":
-            score = gate = self._score(peak)
-        else:
-            score, gate = self._psr_scores(peak, _psr(response))
-        if s.slow_rate > 0:
-            response = self._long_term(features, response, score, update_frame)
+        patch = self._window_patch(self._region(frame))
+        response = self._translation.respond(self._features(patch))
+        peak = float(response.max())
         if s.colour_weight > 0:
             colour = box_response(self._colour.likelihood(colour_index(patch)), CELL, self._colour_box)
             response = (1 - s.colour_weight) * response + s.colour_weight * colour
         row, col = np.unravel_index(int(np.argmax(response)), response.shape)
         shift = np.array([col + _subcell(response[row, :], col), row + _subcell(response[:, col], row)])
         shift -= np.array([response.shape[1] // 2, response.shape[0] // 2])
-        self._center = self._center + shift * CELL * (self._base_window * self._scale * factor) / np.array(self._patch_size)
-        if factor != 1.0 and s.min_scale <= self._scale * factor <= s.max_scale:
-            self._scale *= factor
+        self._center = self._center + shift * CELL * (self._base_window * self._scale) / np.array(self._patch_size)
+        score = self._score(peak)
         self._frames += 1
-        if update_frame:
-            self._rescale_and_learn(frame, gate)
+        if self._frames % s.update_every == 0:
+            self._rescale_and_learn(frame, score)
         w, h = self._base_size * self._scale
         return from_center(float(self._center[0]), float(self._center[1]), float(w), float(h)), score
-
-    def _psr_scores(self, peak: float, psr: float) -> tuple[float, float]:
-        """lab: (score, learning gate) from the PSR relative to its typical value."""
-        s = self.settings
-        if self._typical_psr_frames == 0:
-            self._typical_psr = psr
-        relative_psr = float(np.clip(psr / max(self._typical_psr, 1e-6), 0.0, 1.0))
-        if s.score_by == "psr":
-            score = relative_psr
-        else:
-            if self._typical_frames == 0:
-                self._typical_peak = peak
-            score = float(np.clip(peak / max(self._typical_peak, 1e-6), 0.0, 1.0))
-        if relative_psr >= s.learn_above:
-            self._typical_psr_frames += 1
-            rate = max(s.peak_rate * relative_psr, 1.0 / self._typical_psr_frames)
-            self._typical_psr = (1 - rate) * self._typical_psr + rate * psr
-            if s.score_by != "psr":
-                self._typical_frames += 1
-                rate = max(s.peak_rate * relative_psr, 1.0 / self._typical_frames)
-                self._typical_peak = (1 - rate) * self._typical_peak + rate * peak
-        return score, relative_psr
-
-    def _long_term(self, features: np.ndarray, response: np.ndarray, score: float, update_frame: bool) -> np.ndarray:
-        """lab: the long-term filter's response where it is clearly surer than the fast one's."""
-        s = self.settings
-        weak = score < s.slow_below
-        learning = update_frame and score >= s.slow_learn_above
-        if not (weak or learning):
-            return response
-        slow = self._slow.respond(features)
-        peak = float(slow.max())
-        if self._slow_frames == 0:
-            self._slow_typical = peak
-        relative = float(np.clip(peak / max(self._slow_typical, 1e-6), 0.0, 1.0))
-        if learning:
-            self._slow_frames += 1
-            rate = max(s.peak_rate * relative, 1.0 / self._slow_frames)
-            self._slow_typical = (1 - rate) * self._slow_typical + rate * peak
-        self._slow_score = score
-        if weak and relative > s.slow_beats * score:
-            return slow
-        return response
 
     def _score(self, peak: float) -> float:
         """The peak relative to its running typical value: 1 as usual, towards 0 as it collapses.
@@ -220,10 +136,6 @@ class DcfBackend:
         """The scale step at the new position, then (unless ``score`` is too low) the lesson."""
         s = self.settings
         region = self._region(frame)
-        if not s.scale_filter:
-            if score >= s.learn_above:
-                self._learn(region, score=score)
-            return
         samples = self._scale_samples(region)
         spectrum = self._scale_estimator.spectrum(samples)
         step = self._scale_estimator.best_step(spectrum)
@@ -234,24 +146,18 @@ class DcfBackend:
             if step != 0:
                 region = self._region(frame)  # the window follows the new scale
                 spectrum = self._scale_estimator.spectrum(np.roll(samples, -step, axis=0))  # re-centred on it
-            self._learn(region, scale_spectrum=spectrum, score=score)
+            self._learn(region, scale_spectrum=spectrum)
 
-    def _learn(self, region: _Region, restart: bool = False, scale_spectrum: np.ndarray | None = None,
-               score: float = 1.0) -> None:
+    def _learn(self, region: _Region, restart: bool = False, scale_spectrum: np.ndarray | None = None) -> None:
         """Teach the three models the subject in ``region``: afresh, or at the per-frame rates
         times ``update_every`` (the frames in between teach nothing)."""
         s = self.settings
         k = s.update_every
         patch = self._window_patch(region)
-        features = self._features(patch)
-        self._translation.learn(features, 1.0 if restart else k * s.learning_rate)
-        if s.slow_rate > 0 and (restart or score >= s.slow_learn_above):
-            self._slow.learn(features, 1.0 if restart else k * s.learning_rate * s.slow_rate)
+        self._translation.learn(self._features(patch), 1.0 if restart else k * s.learning_rate)
         if s.colour_weight > 0:
             fg, bg = self._masks
             self._colour.learn(colour_index(patch), fg, bg, 1.0 if restart else k * s.colour_rate)
-        if not s.scale_filter:
-            return
         if scale_spectrum is None:
             scale_spectrum = self._scale_estimator.spectrum(self._scale_samples(region))
         self._scale_estimator.learn(scale_spectrum, 1.0 if restart else k * s.scale_rate)
@@ -260,11 +166,11 @@ class DcfBackend:
         """The window around the subject, cut once per position and scale; every patch comes from it."""
         return _Region.cut(frame, self._center, self._base_window * self._scale, np.array(self._patch_size))
 
-    def _window_patch(self, region: _Region, factor: float = 1.0) -> np.ndarray:
+    def _window_patch(self, region: _Region) -> np.ndarray:
         """The window resampled to the patch size in one bilinear warp, at under 4:1 (see ``_Region``):
         a crop then an area resize cost several times as much and scored the same (docs/tracker-lab.md), and
         averaging the region down further to keep bilinear under 2:1 scored lower on perturbed starts."""
-        window = self._base_window * self._scale * factor / region.k
+        window = self._base_window * self._scale / region.k
         return resample_window(region.image, region.to_region(self._center), window, self._patch_size)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
@@ -321,15 +227,6 @@ def _span(center: float, half: float, size: int, k: int) -> tuple[int, int]:
     end = min(max(math.ceil(center + half), start + 1), size)
     end = start + max(k, (end - start) // k * k)
     return (start, end) if end <= size else (max(0, size - (end - start)), size)
-
-
-def _psr(response: np.ndarray, half: int = 2) -> float:
-    """lab: peak-to-sidelobe ratio, the sidelobe outside the (2 half + 1)^2 cells around the peak."""
-    row, col = np.unravel_index(int(np.argmax(response)), response.shape)
-    mask = np.ones(response.shape, dtype=bool)
-    mask[max(0, row - half):row + half + 1, max(0, col - half):col + half + 1] = False
-    side = response[mask]
-    return float((response[row, col] - side.mean()) / (side.std() + 1e-6))
 
 
 def _subcell(values: np.ndarray, index: int) -> float:

@@ -95,6 +95,21 @@ def test_colour_model_tells_the_subject_from_the_background():
     assert np.unravel_index(np.argmax(response), response.shape) == (4, 4)
 
 
+def test_colour_model_takes_a_shade_of_the_subject_for_the_subject():
+    """16 levels per channel: a subject seen in one shade of red is still recognised a few levels
+    lighter (a 32-level histogram had no count there, so the shade scored as background)."""
+    patch = np.zeros((40, 40, 3), np.uint8)
+    patch[..., 0] = 200  # blue background
+    patch[12:24, 12:24] = (0, 0, 194)  # a red subject
+    foreground = np.zeros((40, 40), bool)
+    foreground[13:23, 13:23] = True
+    model = ColourModel()
+    model.learn(colour_index(patch), foreground, ~foreground, rate=1.0)
+    lighter = patch.copy()
+    lighter[12:24, 12:24] = (6, 6, 202)
+    assert model.likelihood(colour_index(lighter))[18, 18] > 0.9
+
+
 def test_colour_model_learns_at_its_rate():
     """The subject's lower half takes the background's colour, learnt at rate 0.5: that colour's
     foreground share is 0.5 x 0 + 0.5 x 0.5, against a background share of 1."""
