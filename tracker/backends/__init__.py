@@ -20,12 +20,18 @@ from tracker.runtime.boxes import Box, cut_to_frame
 from tracker.runtime.frames import as_bgr, as_bgr_or_grey
 
 
+#: The optional checks of a backend's last box that take no frame (see ``TrackingBackend``).
+VERIFICATIONS = ("anchor_likeness", "second_opinion")
+
+
 class TrackingBackend(Protocol):
     """Follows one box from frame to frame; knows nothing about loss or re-acquisition. A backend
     may also offer ``likeness(frame, box)``: a box's likeness to the subject in its own features over
     their typical value, which a re-acquisition must then reach (``NanoTrackBackend``), and
     ``anchor_likeness()``: the last box's likeness to the subject as first seen, over its early value,
-    which the subject tracker may require of a box before trusting it (``TrackerSettings.verify_deep``)."""
+    which the subject tracker may require of a box before trusting it (``TrackerSettings.verify_deep``),
+    and ``second_opinion()``: an independent model's confidence in the last box, which may vouch for
+    a box that check doubts (``TrackerSettings.verify_second``)."""
 
     name: str
 
@@ -57,10 +63,13 @@ class ConvertingBackend:
         score = getattr(self._backend, "likeness", None)
         return score(self._convert(frame), box) if score is not None else 1.0
 
-    def anchor_likeness(self) -> float:
-        """The wrapped backend's ``anchor_likeness()`` (1 for a backend without one)."""
-        anchor = getattr(self._backend, "anchor_likeness", None)
-        return anchor() if anchor is not None else 1.0
+    def __getattr__(self, name: str) -> Callable[[], float]:
+        """The wrapped backend's frame-free checks (``VERIFICATIONS``) where it has them, so that a
+        check the backend lacks stays missing here too (the subject tracker refuses settings that
+        need it) instead of passing every box."""
+        if name in VERIFICATIONS:
+            return getattr(self._backend, name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
 
 class OpenCvBackend:

@@ -39,6 +39,7 @@ class FusedBackend:
         self.params = params or FusionParams()
         self._primary = primary
         self._checker = checker
+        self._checker_confidence = 0.0
 
     def init(self, frame: np.ndarray, box: Box) -> None:
         self._primary.init(frame, box)
@@ -46,10 +47,12 @@ class FusedBackend:
 
     def update(self, frame: np.ndarray) -> tuple[Box | None, float]:
         box, score = self._primary.update(frame)
+        self._checker_confidence = 0.0
         if box is None:
             return box, score
         self._checker.relocate(box)
         checked, confidence = self._checker.update(frame)
+        self._checker_confidence = confidence if checked is not None else 0.0
         if checked is None or confidence < self.params.fuse_above:
             return box, score
         weight = self.params.vit_weight
@@ -63,3 +66,6 @@ class FusedBackend:
         """The primary's likeness to the subject as first seen (see ``NanoTrackBackend.anchor_likeness``),
         so the subject tracker's verification holds for the fused tracker as for ``nanotrack3``."""
         return self._primary.anchor_likeness()
+
+    def second_opinion(self) -> float:
+        return self._checker_confidence

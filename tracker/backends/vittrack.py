@@ -32,6 +32,9 @@ TEMPLATE_FACTOR = 2.0  # template crop side over the box's geometric-mean side
 SEARCH_FACTOR = 4.0  # search crop side over the box's geometric-mean side
 MEAN = np.array([0.485, 0.456, 0.406], np.float32)  # per channel, in the order fed (B, G, R)
 STD = np.array([0.229, 0.224, 0.225], np.float32)
+#: Each channel's normalised value for every 8-bit level (3, 256): a lookup per pixel costs a quarter
+#: of the arithmetic on a whole float crop, for the same float32 values.
+_LEVELS = ((np.arange(256, dtype=np.float32)[None] / np.float32(255.0) - MEAN[:, None]) / STD[:, None]).astype(np.float32)
 MIN_SIZE = 4.0  # smallest box side kept, pixels
 
 
@@ -58,8 +61,10 @@ def normalised_blob(crop: np.ndarray) -> np.ndarray:
     ``MEAN`` over ``STD``."""
     if crop.ndim == 2:
         crop = cv2.cvtColor(crop, cv2.COLOR_GRAY2BGR)
-    scaled = (crop.astype(np.float32) / 255.0 - MEAN) / STD
-    return scaled.transpose(2, 0, 1)[None]
+    blob = np.empty((1, 3, *crop.shape[:2]), np.float32)
+    for channel in range(3):
+        np.take(_LEVELS[channel], crop[:, :, channel], out=blob[0, channel])
+    return blob
 
 
 def decode_peak(conf: np.ndarray, size: np.ndarray, offset: np.ndarray,

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 from tracker.backends import BACKEND_NAMES, MODEL_BACKENDS, make_backend
@@ -39,11 +40,14 @@ EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # reporting for nanotrack3").
 _NANOTRACK3 = TrackerSettings(track_confidence=0.1, pixel_weight=0.0, verify_deep=0.85, size_pixel=0.6,
                               return_size_ratio=0.85, search_scales=(0.8, 1.0, 1.25),
-                              reacquire_score=0.6, reacquire_deep_likeness=1.0)
+                              reacquire_score=0.6, reacquire_deep_likeness=1.0, unverified_pull=1.0)
+# ``nanovit``'s score and deep likeness are NanoTrack v3's, so it takes those settings; VitTrack's
+# confidence at its box vouches for a box they doubt (a turning subject: docs/tracker-lab.md).
+_NANOVIT = replace(_NANOTRACK3, verify_second=0.4)
 _SETTINGS = {"dcf": TrackerSettings(refine_blend=0.0, reacquire_after_frames=TrackerSettings.lost_after_frames + 1,
                                     pixel_weight=0.5),
              "nanotrack3": _NANOTRACK3,
-             "nanovit": _NANOTRACK3}  # its score and deep likeness are NanoTrack v3's
+             "nanovit": _NANOVIT}
 
 
 def available_trackers() -> list[str]:

@@ -54,6 +54,16 @@ class TrackerSettings:
     # this share of the subject's size: the part in view of a subject coming back in is no measure of
     # its size, and a backend that took the sliver up grows its box only slowly. 0: off.
     return_size_ratio: float = 0.0
+    # A box that fails that check may still be vouched for by a second model: the backend's
+    # ``second_opinion()`` (``nanovit``: VitTrack's confidence at the box) reaching this. A turning
+    # subject that both the first look and the pixels no longer match keeps that model's confidence;
+    # a cover or bare background does not. 0: off.
+    verify_second: float = 0.0
+    # While searching, the Kalman filter follows an unverified box with the backend's score times
+    # this as its confidence (the state stays ``searching``, so the gimbal holds): a subject the
+    # check cannot confirm is more often where the backend has it than where it was last confirmed.
+    # A ``lost`` box still holds still. 0: such a box pulls with the doubted confidence only.
+    unverified_pull: float = 0.0
 
 
 class SubjectTracker:
@@ -73,6 +83,7 @@ class SubjectTracker:
         self._backend = backend
         self._detector = detector
         self.settings = settings or TrackerSettings()
+        _check_verifications(backend, self.settings)
         self._kalman = BoxKalman()
         self._appearance: AppearanceModel | None = None
         self._size: tuple[float, float] = (0.0, 0.0)  # the subject's size when last seen confidently
@@ -123,16 +134,17 @@ class SubjectTracker:
             self._kalman.stop()
             return self._estimate(confidence, TrackState.LOST, timestamp)
         if box is not None:
-            self._kalman.correct(box, confidence)
+            pull = backend_score * s.unverified_pull if not verified else 0.0
+            self._kalman.correct(box, max(confidence, pull))
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
     def _holds_subject(self, similarity: float) -> bool:
-        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off)."""
+        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off):
+        by its pixels, its deep likeness to the first look, or a second model's confidence."""
         s = self.settings
-        if s.verify_deep <= 0.0 or similarity >= s.verify_pixel:
+        if s.verify_deep <= 0.0 or similarity >= s.verify_pixel or self._backend.anchor_likeness() >= s.verify_deep:
             return True
-        anchor = getattr(self._backend, "anchor_likeness", None)
-        return anchor is None or anchor() >= s.verify_deep
+        return s.verify_second > 0.0 and self._backend.second_opinion() >= s.verify_second
 
     def _a_sliver(self, frame: np.ndarray, box: Box) -> bool:
         """Whether ``box``, after misses, is at the frame's edge and smaller than ``return_size_ratio``
@@ -213,6 +225,15 @@ class SubjectTracker:
         box = self._kalman.box
         return TargetEstimate(box=box, velocity=self._kalman.velocity, confidence=float(np.clip(confidence, 0, 1)),
                               state=state, timestamp=timestamp, frame_index=self._frame_index)
+
+
+def _check_verifications(backend: TrackingBackend, settings: TrackerSettings) -> None:
+    """``ValueError`` where ``settings`` switch on a check ``backend`` cannot make: a check that is
+    skipped would trust every box the backend gives."""
+    needs = {"anchor_likeness": settings.verify_deep > 0.0, "second_opinion": settings.verify_second > 0.0}
+    missing = [name for name, needed in needs.items() if needed and getattr(backend, name, None) is None]
+    if missing:
+        raise ValueError(f"tracker settings need the backend's {', '.join(missing)}, which {backend.name} lacks")
 
 
 def _check_timestamp(timestamp: float) -> None:

@@ -85,3 +85,19 @@ def test_the_anchor_likeness_is_nanotracks_so_the_verification_holds_for_nanovit
         alone.update(_frame(x, 150))
         assert fused.anchor_likeness() == pytest.approx(alone.anchor_likeness())
     assert fused.anchor_likeness() < 1.0
+
+
+def test_the_second_opinion_is_vittracks_confidence_at_nanotracks_box(wide_vit, monkeypatch):
+    """``second_opinion`` vouches for a box NanoTrack's own checks doubt, so it must be VitTrack's
+    confidence on this frame: high on the subject, low once it has gone."""
+    fused = _fused(wide_vit)
+    fused.init(_frame(200, 150), (200.0, 150.0, SIDE, SIDE))
+    said = []
+    checker_update = fused._checker.update
+    monkeypatch.setattr(fused._checker, "update", lambda frame: said.append(checker_update(frame)) or said[-1])
+    opinions = []
+    for x in (204, -1):
+        fused.update(_frame(x, 150))
+        opinions.append(fused.second_opinion())
+    assert opinions == [confidence if box is not None else 0.0 for box, confidence in said]
+    assert opinions[0] > 0.5 > opinions[1]

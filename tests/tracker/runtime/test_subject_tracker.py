@@ -388,3 +388,71 @@ def test_the_pixels_verify_a_box_the_deep_check_doubts():
     subject = SubjectTracker("anchored", backend, None, TrackerSettings(pixel_weight=0.0, verify_deep=0.85))
     subject.init(seq.frames[0], seq.boxes[0], 0.0)
     assert [e.state for e in follow(subject, seq.frames[1:])] == [TrackState.TRACKING] * 9
+
+
+class _VouchedBackend(_AnchoredBackend):
+    """An anchored backend whose second model gives a fixed ``second_opinion()``."""
+
+    def __init__(self, answer, anchor: float, opinion: float) -> None:
+        super().__init__(answer, anchor)
+        self.opinion = opinion
+
+    def second_opinion(self) -> float:
+        return self.opinion
+
+
+def _states_vouched(opinion: float, **settings: float) -> list[TrackState]:
+    """States on the rendered subject's scene without it while the backend answers its last box
+    with score 1, its deep check doubting (0.5) and a second model giving ``opinion``."""
+    seq = render_sequence(frames=2, seed=3)
+    backend = _VouchedBackend(lambda n, restarts: (tuple(float(v) for v in seq.boxes[0]), 1.0), 0.5, opinion)
+    subject = SubjectTracker("vouched", backend, None, TrackerSettings(pixel_weight=0.0, verify_deep=0.85, **settings))
+    subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    return [e.state for e in follow(subject, [empty_scene(3)] * 20)]
+
+
+def test_a_second_models_confidence_vouches_for_a_box_the_deep_check_doubts():
+    assert _states_vouched(0.6, verify_second=0.4) == [TrackState.TRACKING] * 20
+    assert _states_vouched(0.3, verify_second=0.4)[-1] is TrackState.LOST  # under the bar: no vouching
+    assert _states_vouched(0.6)[-1] is TrackState.LOST  # verify_second off: the second model is not asked
+
+
+@pytest.mark.parametrize("settings, needed", [({"verify_deep": 0.85}, "anchor_likeness"),
+                                              ({"verify_deep": 0.85, "verify_second": 0.4}, "second_opinion")])
+def test_a_check_the_backend_cannot_make_is_refused_not_skipped(settings, needed):
+    """A wrapped backend without the check must not pass every box (``ConvertingBackend`` used to
+    answer 1 for a missing ``anchor_likeness``)."""
+    from tracker.backends import ConvertingBackend
+    wrapped = ConvertingBackend(_AnchoredBackend(lambda n, restarts: (None, 0.0), 0.5) if needed == "second_opinion"
+                                else ScriptedBackend(lambda n, restarts: (None, 0.0)), lambda frame: frame)
+    with pytest.raises(ValueError, match=needed):
+        SubjectTracker("wrapped", wrapped, None, TrackerSettings(**settings))
+
+
+def test_a_wrapped_backend_passes_its_checks_through():
+    from tracker.backends import ConvertingBackend
+    wrapped = ConvertingBackend(_VouchedBackend(lambda n, restarts: (None, 0.0), 0.7, 0.6), lambda frame: frame)
+    assert (wrapped.anchor_likeness(), wrapped.second_opinion()) == (0.7, 0.6)
+
+
+def _box_while_doubted(pull: float) -> tuple[list[TargetEstimate], list[Box]]:
+    """Estimates while an anchored backend follows the moving subject with score 1, its deep check
+    doubting every box after the start and the pixels (a blank scene) not vouching either."""
+    seq = render_sequence(frames=30, speed=3.0, seed=3)
+    backend = _AnchoredBackend(lambda n, restarts: (tuple(float(v) for v in seq.boxes[n]), 1.0), 0.5)
+    subject = SubjectTracker("anchored", backend, None,
+                             TrackerSettings(pixel_weight=0.0, verify_deep=0.85, unverified_pull=pull))
+    subject.init(seq.frames[0], seq.boxes[0], 0.0)
+    return follow(subject, [np.full_like(seq.frames[0], 128)] * 29), seq.boxes[1:]
+
+
+def test_while_searching_the_box_follows_an_unverified_box_when_told_to():
+    followed, truth = _box_while_doubted(1.0)
+    held, _ = _box_while_doubted(0.0)
+    searching = [i for i, e in enumerate(followed) if e.state is TrackState.SEARCHING]
+    assert len(searching) >= 10 and [e.state for e in held] == [e.state for e in followed]  # same states
+    late = searching[5:]
+    assert all(iou(followed[i].box, truth[i]) > 0.7 for i in late)
+    assert all(iou(held[i].box, truth[i]) < 0.5 for i in late)
+    lost = [e for e in followed if e.state is TrackState.LOST]
+    assert lost and np.ptp([e.box[:2] for e in lost], axis=0) == pytest.approx((0.0, 0.0), abs=0.5)
