@@ -49,6 +49,8 @@ class DcfSettings:
     # tracker whose accuracy stays within the noise of learning every frame; 3 gained little more
     # speed in the loop, 5 lost accuracy (docs/tracker-lab.md).
     update_every: int = 2
+    normalised_blend: bool = False
+    hsv_colour: bool = False
 
     def __post_init__(self) -> None:
         if self.update_every < 1:
@@ -101,7 +103,9 @@ class DcfBackend:
         response = self._translation.respond(self._features(patch))
         peak = float(response.max())
         if s.colour_weight > 0:
-            colour = box_response(self._colour.likelihood(colour_index(patch)), CELL, self._colour_box)
+            if s.normalised_blend:
+                response = response / max(self._typical_peak, 1e-6)
+            colour = box_response(self._colour.likelihood(colour_index(self._colour_patch(patch))), CELL, self._colour_box)
             response = (1 - s.colour_weight) * response + s.colour_weight * colour
         row, col = np.unravel_index(int(np.argmax(response)), response.shape)
         shift = np.array([col + _subcell(response[row, :], col), row + _subcell(response[:, col], row)])
@@ -157,7 +161,7 @@ class DcfBackend:
         self._translation.learn(self._features(patch), 1.0 if restart else k * s.learning_rate)
         if s.colour_weight > 0:
             fg, bg = self._masks
-            self._colour.learn(colour_index(patch), fg, bg, 1.0 if restart else k * s.colour_rate)
+            self._colour.learn(colour_index(self._colour_patch(patch)), fg, bg, 1.0 if restart else k * s.colour_rate)
         if scale_spectrum is None:
             scale_spectrum = self._scale_estimator.spectrum(self._scale_samples(region))
         self._scale_estimator.learn(scale_spectrum, 1.0 if restart else k * s.scale_rate)
@@ -172,6 +176,11 @@ class DcfBackend:
         averaging the region down further to keep bilinear under 2:1 scored lower on perturbed starts."""
         window = self._base_window * self._scale / region.k
         return resample_window(region.image, region.to_region(self._center), window, self._patch_size)
+
+    def _colour_patch(self, patch: np.ndarray) -> np.ndarray:
+        if self.settings.hsv_colour and patch.ndim == 3:
+            return cv2.cvtColor(patch, cv2.COLOR_BGR2HSV_FULL)
+        return patch
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
         return cell_features(unit_grey(patch)[None])[0]
