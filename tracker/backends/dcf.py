@@ -51,6 +51,7 @@ class DcfSettings:
     update_every: int = 2
     normalised_blend: bool = False
     hsv_colour: bool = False
+    warm_up: bool = False
 
     def __post_init__(self) -> None:
         if self.update_every < 1:
@@ -157,14 +158,16 @@ class DcfBackend:
         times ``update_every`` (the frames in between teach nothing)."""
         s = self.settings
         k = s.update_every
+        self._lessons = 0 if restart else self._lessons + 1
+        warm = 1.0 / (self._lessons + 1) if s.warm_up else 0.0
         patch = self._window_patch(region)
-        self._translation.learn(self._features(patch), 1.0 if restart else k * s.learning_rate)
+        self._translation.learn(self._features(patch), 1.0 if restart else max(warm, k * s.learning_rate))
         if s.colour_weight > 0:
             fg, bg = self._masks
-            self._colour.learn(colour_index(self._colour_patch(patch)), fg, bg, 1.0 if restart else k * s.colour_rate)
+            self._colour.learn(colour_index(self._colour_patch(patch)), fg, bg, 1.0 if restart else max(warm, k * s.colour_rate))
         if scale_spectrum is None:
             scale_spectrum = self._scale_estimator.spectrum(self._scale_samples(region))
-        self._scale_estimator.learn(scale_spectrum, 1.0 if restart else k * s.scale_rate)
+        self._scale_estimator.learn(scale_spectrum, 1.0 if restart else max(warm, k * s.scale_rate))
 
     def _region(self, frame: np.ndarray) -> _Region:
         """The window around the subject, cut once per position and scale; every patch comes from it."""
