@@ -52,6 +52,7 @@ class DcfSettings:
     normalised_blend: bool = False
     hsv_colour: bool = False
     warm_up: bool = False
+    scale_when_sure: bool = False
 
     def __post_init__(self) -> None:
         if self.update_every < 1:
@@ -145,6 +146,8 @@ class DcfBackend:
         spectrum = self._scale_estimator.spectrum(samples)
         step = self._scale_estimator.best_step(spectrum)
         if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
+            step = 0
+        if s.scale_when_sure and score < s.learn_above:
             step = 0
         self._scale *= s.scale_step**step
         if score >= s.learn_above:
