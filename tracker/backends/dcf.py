@@ -49,10 +49,6 @@ class DcfSettings:
     # tracker whose accuracy stays within the noise of learning every frame; 3 gained little more
     # speed in the loop, 5 lost accuracy (docs/tracker-lab.md).
     update_every: int = 2
-    normalised_blend: bool = False
-    hsv_colour: bool = False
-    warm_up: bool = False
-    scale_when_sure: bool = False
 
     def __post_init__(self) -> None:
         if self.update_every < 1:
@@ -105,9 +101,7 @@ class DcfBackend:
         response = self._translation.respond(self._features(patch))
         peak = float(response.max())
         if s.colour_weight > 0:
-            if s.normalised_blend:
-                response = response / max(self._typical_peak, 1e-6)
-            colour = box_response(self._colour.likelihood(colour_index(self._colour_patch(patch))), CELL, self._colour_box)
+            colour = box_response(self._colour.likelihood(colour_index(patch)), CELL, self._colour_box)
             response = (1 - s.colour_weight) * response + s.colour_weight * colour
         row, col = np.unravel_index(int(np.argmax(response)), response.shape)
         shift = np.array([col + _subcell(response[row, :], col), row + _subcell(response[:, col], row)])
@@ -147,8 +141,6 @@ class DcfBackend:
         step = self._scale_estimator.best_step(spectrum)
         if not s.min_scale <= self._scale * s.scale_step**step <= s.max_scale:
             step = 0
-        if s.scale_when_sure and score < s.learn_above:
-            step = 0
         self._scale *= s.scale_step**step
         if score >= s.learn_above:
             if step != 0:
@@ -161,16 +153,14 @@ class DcfBackend:
         times ``update_every`` (the frames in between teach nothing)."""
         s = self.settings
         k = s.update_every
-        self._lessons = 0 if restart else self._lessons + 1
-        warm = 1.0 / (self._lessons + 1) if s.warm_up else 0.0
         patch = self._window_patch(region)
-        self._translation.learn(self._features(patch), 1.0 if restart else max(warm, k * s.learning_rate))
+        self._translation.learn(self._features(patch), 1.0 if restart else k * s.learning_rate)
         if s.colour_weight > 0:
             fg, bg = self._masks
-            self._colour.learn(colour_index(self._colour_patch(patch)), fg, bg, 1.0 if restart else max(warm, k * s.colour_rate))
+            self._colour.learn(colour_index(patch), fg, bg, 1.0 if restart else k * s.colour_rate)
         if scale_spectrum is None:
             scale_spectrum = self._scale_estimator.spectrum(self._scale_samples(region))
-        self._scale_estimator.learn(scale_spectrum, 1.0 if restart else max(warm, k * s.scale_rate))
+        self._scale_estimator.learn(scale_spectrum, 1.0 if restart else k * s.scale_rate)
 
     def _region(self, frame: np.ndarray) -> _Region:
         """The window around the subject, cut once per position and scale; every patch comes from it."""
@@ -182,11 +172,6 @@ class DcfBackend:
         averaging the region down further to keep bilinear under 2:1 scored lower on perturbed starts."""
         window = self._base_window * self._scale / region.k
         return resample_window(region.image, region.to_region(self._center), window, self._patch_size)
-
-    def _colour_patch(self, patch: np.ndarray) -> np.ndarray:
-        if self.settings.hsv_colour and patch.ndim == 3:
-            return cv2.cvtColor(patch, cv2.COLOR_BGR2HSV_FULL)
-        return patch
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
         return cell_features(unit_grey(patch)[None])[0]
