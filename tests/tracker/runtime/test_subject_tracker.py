@@ -94,15 +94,15 @@ def test_update_before_init_is_an_error():
         make_tracker().update(np.zeros((10, 10, 3), np.uint8), 0.0)
 
 
-def test_default_without_nanotrack_files_is_nanotrack3(tmp_path):
-    assert make_tracker("default", tmp_path).name == "nanotrack3"
+def test_default_without_model_files_is_nanovit(tmp_path):
+    assert make_tracker("default", tmp_path).name == "nanovit"
 
 
-def test_nano_follows_and_is_default_with_model_files(shared_data):
+def test_nanotrack_v2_follows_on_the_shared_model_files_and_the_default_stays_nanovit(shared_data):
     models = shared_data / "models"
-    assert make_tracker("default", models).name == "nanotrack"
+    assert make_tracker("default", models).name == "nanovit"
     seq = render_sequence(frames=50, seed=7)
-    estimates = _track("default", seq, models)
+    estimates = _track("nanotrack", seq, models)
     assert success_auc([e.box for e in estimates], seq.boxes) > 0.6
 
 
