@@ -54,16 +54,19 @@ def test_the_default_reads_a_model_dir_holding_all_its_files_and_else_the_shippe
 
 
 @pytest.mark.parametrize("damage", ["missing", "junk"])
-def test_the_default_falls_back_to_dcf_with_a_warning_where_its_model_cannot_load(tmp_path, monkeypatch, damage):
+@pytest.mark.parametrize("path, name", [("nanotrack_v3/nanotrack_head.onnx", EMBEDDED_TRACKER),
+                                        ("vittrack/vitTracker.onnx", "nanovit")])
+def test_the_default_falls_back_to_dcf_with_a_warning_where_its_model_cannot_load(tmp_path, monkeypatch, damage,
+                                                                                   path, name):
     shutil.copytree(EMBEDDED_MODELS, tmp_path / "models")
-    head = tmp_path / "models" / "nanotrack_v3" / "nanotrack_head.onnx"
-    head.unlink() if damage == "missing" else head.write_bytes(b"junk!")
+    damaged = tmp_path / "models" / path
+    damaged.unlink() if damage == "missing" else damaged.write_bytes(b"junk!")
     monkeypatch.setattr(registry, "EMBEDDED_MODELS", tmp_path / "models")
-    with pytest.warns(registry.TrackerFallbackWarning, match="nanotrack_head.*; using dcf$"):
+    with pytest.warns(registry.TrackerFallbackWarning, match=f"{damaged.stem}.*; using dcf$"):
         subject = make_tracker()
     assert subject.name == "dcf" and subject.model is None
-    with pytest.raises((ValueError, FileNotFoundError), match="nanotrack_head"):  # asked for by name: an error
-        make_tracker(EMBEDDED_TRACKER)
+    with pytest.raises((ValueError, FileNotFoundError), match=damaged.stem):  # asked for by name: an error
+        make_tracker(name)
 
 
 def test_a_damaged_embedded_file_is_named(tmp_path, monkeypatch):
