@@ -16,7 +16,7 @@ from pipelines.cli.common import CliError, existing_dir, existing_file
 from pipelines.outputs.progress import ProgressReporter
 from tracker.evaluation import SequenceResult, first_box, run_sequence, summarize
 from tracker.evaluation.datasets import GROUNDTRUTH_NAMES, FrameReadError, Sequence, load_sequence
-from tracker.runtime.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, FALLBACK_BACKEND, available_trackers, make_tracker
+from tracker.runtime.registry import DEFAULT_BACKEND, FALLBACK_BACKEND, available_trackers, make_tracker
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -47,8 +47,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "its video (OTB x,y,w,h or VOT polygon lines, one per frame)")
     parser.add_argument("--tracker", default="default", metavar="NAME",
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
-                        f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND} on the model files "
-                        f"shipped with gimbaltrack, or {FALLBACK_BACKEND} where they cannot be loaded)")
+                        f"{DEFAULT_BACKEND} on the model files shipped with gimbaltrack, or on --model-dir's where it "
+                        f"holds them all, or {FALLBACK_BACKEND} where they cannot be loaded)")
     parser.add_argument("--model-dir", type=existing_dir, metavar="DIR",
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "
                         "nanotrack_head*.onnx, directly or in nanotrack_v2/ (default: the files shipped with gimbaltrack)")

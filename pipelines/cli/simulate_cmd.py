@@ -19,7 +19,7 @@ from pipelines.loop.closed_loop import ORACLE, LoopResult, LoopSettings, Prepare
 from pipelines.outputs.latency import latency_percentiles
 from pipelines.outputs.progress import ProgressReporter
 from pipelines.outputs.summary import write_summary
-from tracker.runtime.registry import DEFAULT_BACKEND, DEFAULT_WITH_MODELS, FALLBACK_BACKEND, available_trackers
+from tracker.runtime.registry import DEFAULT_BACKEND, FALLBACK_BACKEND, available_trackers
 
 if TYPE_CHECKING:
     from pipelines.loop import FrameRecord
@@ -55,8 +55,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "or p (speed proportional to pixel error, the public-driver baseline)")
     parser.add_argument("--tracker", default="default", choices=[ORACLE, *available_trackers()], metavar="NAME",
                         help=f"one of: {', '.join(available_trackers())} (default: default = "
-                        f"{DEFAULT_WITH_MODELS} when --model-dir holds its files, else {DEFAULT_BACKEND} on the model files "
-                        f"shipped with gimbaltrack, or {FALLBACK_BACKEND} where they cannot be loaded), "
+                        f"{DEFAULT_BACKEND} on the model files shipped with gimbaltrack, or on --model-dir's where it "
+                        f"holds them all, or {FALLBACK_BACKEND} where they cannot be loaded), "
                         f"or {ORACLE}: the ground-truth box is the detection, isolating the control loop")
     parser.add_argument("--model-dir", type=existing_dir, metavar="DIR",
                         help="folder with optional model files, e.g. NanoTrack's nanotrack_backbone*.onnx and "

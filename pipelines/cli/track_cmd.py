@@ -31,6 +31,7 @@ from pipelines.loop.track_session import DEFAULT_VIDEO_WIDTH, FEEDBACK_MODES, Tr
 from pipelines.outputs.can_log import CanLogWriter
 from pipelines.sources import FrameSource, SourceError, open_source
 from tracker import SubjectTracker, available_trackers
+from tracker.runtime.registry import DEFAULT_BACKEND, FALLBACK_BACKEND
 from tracker.detectors import Detector
 
 DEFAULT_DETECTOR = "motion"
@@ -75,11 +76,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                          help="which detection to follow (default: largest for motion, else central)")
     subject.add_argument("--tracker", default="default",
                          help=f"tracking backend: {', '.join(available_trackers())} (default: default, which "
-                         "is nanotrack when --model-dir holds its files, else nanotrack3 on the model files shipped with "
-                         "gimbaltrack, or dcf where they cannot be loaded)")
+                         f"is {DEFAULT_BACKEND} on the model files shipped with gimbaltrack, or on --model-dir's where "
+                         f"it holds them all, or {FALLBACK_BACKEND} where they cannot be loaded)")
     subject.add_argument("--model-dir", type=existing_dir,
-                         help="folder with optional model files: NanoTrack v3 (instead of the shipped ones), "
-                         "NanoTrack v2, VitTrack, FEAR-XS and YuNet (then the face detector)")
+                         help="folder with optional model files: NanoTrack v3 and VitTrack (instead of the shipped "
+                         "ones), NanoTrack v2, FEAR-XS and YuNet (then the face detector)")
     control = parser.add_argument_group("control")
     control.add_argument("--controller", choices=controller_names(), default="pid",
                          help="pid: world-frame Kalman + PID + feed-forward (default); p: proportional baseline")

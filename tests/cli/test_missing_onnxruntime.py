@@ -48,5 +48,5 @@ def test_eval_falls_back_to_dcf_with_one_warning_line_and_names_it(tmp_path: Pat
     assert done.returncode == 0, done.stderr
     warnings = [line for line in done.stderr.splitlines() if "warning" in line]
     assert len(warnings) == 1 and "Traceback" not in done.stderr, done.stderr
-    assert "nanotrack3" in warnings[0] and "onnxruntime" in warnings[0] and warnings[0].endswith("using dcf")
+    assert "nanovit" in warnings[0] and "onnxruntime" in warnings[0] and warnings[0].endswith("using dcf")
     assert json.loads(done.stdout.splitlines()[-1])["tracker"] == "dcf"

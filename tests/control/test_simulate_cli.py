@@ -37,7 +37,7 @@ def test_summary_reports_the_tracker_and_field_of_view_used(sequence: Path, tmp_
     summary = json.loads(stdout)
     # crop-equivalent: the 640 px source's focal length (24 mm full frame) seen by a 480 px view
     source_focal = 320 / math.tan(math.radians(DEFAULT_HFOV_DEG) / 2)
-    assert summary["tracker"] == "nanotrack3"  # the default, resolved
+    assert summary["tracker"] == "nanovit"  # the default, resolved
     assert summary["fov_deg"] == pytest.approx(math.degrees(2 * math.atan(240 / source_focal)))
     assert json.loads((out / "summary.json").read_text()) == summary
     code, stdout, _ = simulate([str(sequence), "--fps", "60", "--fov", "50", "--tracker", "oracle"], capsys)
@@ -139,8 +139,8 @@ def test_help_lists_trackers_defaults_and_examples(capsys: pytest.CaptureFixture
         main(["simulate", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "oracle" in text and "dcf" in text and "csrt" in text
-    assert ("(default: default = nanotrack when --model-dir holds its files, else nanotrack3 on the model files "
-            "shipped with gimbaltrack, or dcf where they cannot be loaded)") in text
+    assert ("(default: default = nanovit on the model files shipped with gimbaltrack, or on --model-dir's where "
+            "it holds them all, or dcf where they cannot be loaded)") in text
     assert "(default: none, nothing is written)" in text
     assert "examples: gimbaltrack simulate" in text
 

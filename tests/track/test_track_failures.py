@@ -72,7 +72,7 @@ def test_bad_options_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureF
 def test_wrong_model_files_are_named_in_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                  backbone: bytes, head: bytes, wrong: str) -> None:
     models = fake_onnx.write_nanotrack_files(tmp_path / "models", backbone, head)  # once a cv2.error traceback
-    assert run_track(DEMO, tmp_path / "out", "--roi", DEMO_ROI, "--model-dir", str(models)) == 2
+    assert run_track(DEMO, tmp_path / "out", "--roi", DEMO_ROI, "--tracker", "nanotrack", "--model-dir", str(models)) == 2
     _one_line_error(capsys, wrong)
     assert not (tmp_path / "out").exists()  # checked before it is created, as the source is
 

@@ -68,4 +68,7 @@ class FusedBackend:
         return self._primary.anchor_likeness()
 
     def second_opinion(self) -> float:
+        """VitTrack's windowed confidence at the primary's last box (0 where it gave no box): an
+        opinion independent of NanoTrack's score and features, which stays up on a subject turning
+        out of its first look and falls on a cover (``TrackerSettings.verify_second``)."""
         return self._checker_confidence

@@ -9,20 +9,19 @@ from tracker.backends import BACKEND_NAMES, MODEL_BACKENDS, make_backend
 from tracker.backends.model_files import checked_model_dir
 from tracker.backends.nanotrack import nanotrack_model_files
 from tracker.backends.onnx_sessions import DEFAULT_THREADS
+from tracker.backends.vittrack import vittrack_model_file
 from tracker.detectors import Detector
 from tracker.runtime.subject import SubjectTracker, TrackerSettings
 
-#: The default: NanoTrack v3 on the model files shipped in the package (the best mean AUC on the 19
-#: shared sequences, docs/tracker.md), whose settings below report a hidden or departed subject as
-#: lost. Where its model cannot be loaded (no onnxruntime, a damaged file) the default is
+#: The default: NanoTrack v3 with VitTrack's box averaged in, on the model files shipped in the
+#: package (the best mean AUC on the 19 shared sequences from one start and from eight, at 60 fps or
+#: more at 1280x720: docs/tracker.md), whose settings below report a hidden or departed subject as
+#: lost. Where its models cannot be loaded (no onnxruntime, a damaged file) the default is
 #: ``FALLBACK_BACKEND``, with one warning.
-DEFAULT_BACKEND = "nanotrack3"
+DEFAULT_BACKEND = "nanovit"
 FALLBACK_BACKEND = "dcf"
-DEFAULT_WITH_MODELS = "nanotrack"  # the default when the model folder holds NanoTrack v2's files
-#: The model tracker whose files ship inside the package, so that it needs no model folder.
-EMBEDDED_TRACKER = "nanotrack3"
-#: Every model tracker that runs on the shipped files alone (``nanovit``: NanoTrack v3's and VitTrack's).
-EMBEDDED_TRACKERS = (EMBEDDED_TRACKER, "nanovit")
+#: The model trackers whose files ship inside the package, so that they need no model folder.
+EMBEDDED_TRACKERS = ("nanotrack3", "nanovit")
 EMBEDDED_MODELS = Path(__file__).resolve().parents[1] / "models"
 # The template refinement corrects CSRT's drift; the correlation filter's own peak is finer. The
 # template search may restart dcf only once the subject is lost: dcf keeps following through a few
@@ -61,18 +60,16 @@ def make_tracker(name: str = "default", model_dir: str | Path | None = None,
     """A subject tracker by name; ``detector``, if given, helps it find a lost subject again;
     ``threads``: onnxruntime's intra-op threads for the models that run on it.
 
-    ``default`` is NanoTrack (v2) when ``model_dir`` holds its files, else ``DEFAULT_BACKEND`` on the
-    shipped files (or on ``model_dir``'s files), or ``FALLBACK_BACKEND`` with a
-    ``TrackerFallbackWarning`` where that model cannot be loaded.
+    ``default`` is ``DEFAULT_BACKEND`` on ``model_dir``'s files where it holds them all, else on the
+    shipped files, or ``FALLBACK_BACKEND`` with a ``TrackerFallbackWarning`` where those models cannot
+    be loaded.
     ``EMBEDDED_TRACKERS`` read the files shipped with the package where ``model_dir`` is not given;
     other model trackers need it. Unknown names raise ``ValueError``; missing model files, or a
     ``model_dir`` that is no folder, raise ``FileNotFoundError``; a damaged one ``ValueError``.
     """
     model_dir = checked_model_dir(model_dir)
     if name == "default":
-        if model_dir is None or not _has_nanotrack(model_dir):
-            return _default_tracker(model_dir, detector, threads)
-        name = DEFAULT_WITH_MODELS
+        return _default_tracker(model_dir, detector, threads)
     if name not in BACKEND_NAMES:
         raise ValueError(f"unknown tracker {name!r} (available: {', '.join(available_trackers())})")
     if model_dir is None and name in EMBEDDED_TRACKERS:
@@ -87,9 +84,9 @@ class TrackerFallbackWarning(UserWarning):
 
 
 def _default_tracker(model_dir: Path | None, detector: Detector | None, threads: int) -> SubjectTracker:
-    """``DEFAULT_BACKEND`` on ``model_dir``'s NanoTrack v3 files, else on the shipped ones; where that
-    model cannot be loaded, ``FALLBACK_BACKEND`` and one warning saying why."""
-    models = model_dir if model_dir is not None and _has_nanotrack(model_dir, "v3") else EMBEDDED_MODELS
+    """``DEFAULT_BACKEND`` on ``model_dir``'s NanoTrack v3 and VitTrack files, else on the shipped ones;
+    where those models cannot be loaded, ``FALLBACK_BACKEND`` and one warning saying why."""
+    models = model_dir if model_dir is not None and _holds_default_models(model_dir) else EMBEDDED_MODELS
     try:
         backend = make_backend(DEFAULT_BACKEND, models, threads)
     except (ValueError, FileNotFoundError) as exc:  # RuntimeMissingError (no onnxruntime) is a ValueError
@@ -99,9 +96,11 @@ def _default_tracker(model_dir: Path | None, detector: Detector | None, threads:
     return SubjectTracker(DEFAULT_BACKEND, backend, detector, _SETTINGS.get(DEFAULT_BACKEND), model=str(models))
 
 
-def _has_nanotrack(model_dir: Path, version: str = "v2") -> bool:
+def _holds_default_models(model_dir: Path) -> bool:
+    """Whether ``model_dir`` has every file ``DEFAULT_BACKEND`` reads (NanoTrack v3's and VitTrack's)."""
     try:
-        nanotrack_model_files(model_dir, version)
+        nanotrack_model_files(model_dir, "v3")
+        vittrack_model_file(model_dir)
     except FileNotFoundError:
         return False
     return True

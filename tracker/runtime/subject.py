@@ -118,7 +118,7 @@ class SubjectTracker:
         patch = cut_patch(frame, box) if box is not None else None
         similarity = self._appearance.similarity(patch) if patch is not None else 0.0
         confidence = backend_score * similarity ** s.pixel_weight
-        verified = self._holds_subject(similarity) and not (box is not None and self._a_sliver(frame, box))
+        verified = box is not None and self._holds_subject(frame, box, similarity) and not self._a_sliver(frame, box)
         if not verified:
             confidence = min(confidence, backend_score * similarity)
         if box is not None and verified and confidence >= s.track_confidence:
@@ -138,13 +138,23 @@ class SubjectTracker:
             self._kalman.correct(box, max(confidence, pull))
         return self._estimate(confidence, TrackState.SEARCHING, timestamp)
 
-    def _holds_subject(self, similarity: float) -> bool:
-        """Whether the backend's last box passes the check ``verify_deep`` switches on (True when off):
-        by its pixels, its deep likeness to the first look, or a second model's confidence."""
+    def _holds_subject(self, frame: np.ndarray, box: Box, similarity: float) -> bool:
+        """Whether the backend's ``box`` passes the check ``verify_deep`` switches on (True when off):
+        by its pixels, its deep likeness to the first look, or a second model's confidence. The second
+        model is not asked about a box at the frame's edge: its confidence there is in the part still
+        in view of a subject leaving the picture, not in the box, which lags behind it."""
         s = self.settings
         if s.verify_deep <= 0.0 or similarity >= s.verify_pixel or self._backend.anchor_likeness() >= s.verify_deep:
             return True
-        return s.verify_second > 0.0 and self._backend.second_opinion() >= s.verify_second
+        return (s.verify_second > 0.0 and not self._at_edge(frame, box)
+                and self._backend.second_opinion() >= s.verify_second)
+
+    def _at_edge(self, frame: np.ndarray, box: Box) -> bool:
+        """Whether ``box`` reaches within a tenth of the subject's size of the frame's border."""
+        (w, h), (x, y, bw, bh) = self._size, box
+        height, width = frame.shape[:2]
+        margin = 0.1 * max(w, h)
+        return x <= margin or y <= margin or x + bw >= width - margin or y + bh >= height - margin
 
     def _a_sliver(self, frame: np.ndarray, box: Box) -> bool:
         """Whether ``box``, after misses, is at the frame's edge and smaller than ``return_size_ratio``
@@ -152,11 +162,8 @@ class SubjectTracker:
         ratio = self.settings.return_size_ratio
         if ratio <= 0.0 or self._misses == 0:
             return False
-        (w, h), (x, y, bw, bh) = self._size, box
-        height, width = frame.shape[:2]
-        margin = 0.1 * max(w, h)
-        at_edge = x <= margin or y <= margin or x + bw >= width - margin or y + bh >= height - margin
-        return at_edge and (bw < ratio * w or bh < ratio * h)
+        (w, h), (_, _, bw, bh) = self._size, box
+        return self._at_edge(frame, box) and (bw < ratio * w or bh < ratio * h)
 
     def _backend_likes(self, frame: np.ndarray, box: Box) -> bool:
         """Whether the backend's own likeness of ``box`` to the subject (relative to its typical

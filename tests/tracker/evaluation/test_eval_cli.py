@@ -179,8 +179,8 @@ def test_one_sequence_and_the_overall_print_the_same_scores(tmp_path):
 
 def test_help_states_defaults_and_examples():
     text = " ".join(gimbaltrack(["eval", "--help"]).stdout.split())
-    assert ("(default: default = nanotrack when --model-dir holds its files, else nanotrack3 on the model files "
-            "shipped with gimbaltrack, or dcf where they cannot be loaded)") in text
+    assert ("(default: default = nanovit on the model files shipped with gimbaltrack, or on --model-dir's where "
+            "it holds them all, or dcf where they cannot be loaded)") in text
     assert "nanotrack_v2/ (default: the files shipped with gimbaltrack)" in text and "examples: gimbaltrack eval" in text
 
 

@@ -42,17 +42,19 @@ class _LosesItOnTheThirdFrame:
 
 
 class _TenthOfASecondPerUpdate:
-    """Stands in for ``time`` in tracker.evaluation: every clock reading is 0.05 s after the last,
-    so each timed ``update`` takes 0.1 s of wall-clock and of CPU time."""
+    """Stands in for ``time`` in tracker.evaluation: each clock reads 0.1 s after its own last
+    reading, so each timed ``update`` takes 0.1 s of wall-clock and of CPU time."""
 
     def __init__(self) -> None:
-        self.now = 0.0
+        self.wall = self.cpu = 0.0
 
     def perf_counter(self) -> float:
-        self.now += 0.05
-        return self.now
+        self.wall += 0.1
+        return self.wall
 
-    process_time = perf_counter
+    def process_time(self) -> float:
+        self.cpu += 0.1
+        return self.cpu
 
 
 def test_a_lost_frame_holds_the_last_reported_box(tmp_path: Path) -> None:

@@ -15,12 +15,14 @@ from tests.tracker.scripted_backend import ScriptedBackend
 from tests.tracker.evaluation.test_eval_cli import write_otb
 from tracker.detectors import make_detector
 from tracker.runtime import registry
-from tracker.runtime.registry import DEFAULT_BACKEND, EMBEDDED_MODELS, EMBEDDED_TRACKER, make_tracker
+from tracker.runtime.registry import DEFAULT_BACKEND, EMBEDDED_MODELS, make_tracker
 from tracker.runtime.estimate import TrackState
 
 
-# NanoTrack v3's model files ship inside the package: ``nanotrack3`` runs with no --model-dir, and is
-# the default; where its model cannot be loaded the default is the correlation filter, with a warning.
+# NanoTrack v3's and VitTrack's model files ship inside the package: ``nanotrack3`` and ``nanovit`` run
+# with no --model-dir, and ``nanovit`` is the default; where its models cannot be loaded the default is
+# the correlation filter, with a warning.
+EMBEDDED_TRACKER = "nanotrack3"
 def test_nanotrack3_runs_on_the_embedded_model_files_with_their_licence():
     subject = make_tracker(EMBEDDED_TRACKER)
     assert subject.name == "nanotrack3" and subject.model == str(EMBEDDED_MODELS)
@@ -34,22 +36,37 @@ def test_the_package_data_ships_the_model_folder():
     assert '"tracker" = ["models/*/*"]' in text
 
 
-def test_the_default_is_nanotrack3_on_the_shipped_files_without_a_model_folder():
+def test_the_default_is_nanovit_on_the_shipped_files_without_a_model_folder():
     subject = make_tracker()
-    assert subject.name == "nanotrack3" and subject.model == str(EMBEDDED_MODELS)
+    assert subject.name == "nanovit" and subject.model == str(EMBEDDED_MODELS)
+
+
+def test_the_default_reads_a_model_dir_holding_all_its_files_and_else_the_shipped_ones(tmp_path):
+    """Not NanoTrack v2 where the folder holds it (the default used to switch to it, 0.68 against
+    0.74 on the shared sequences): the default is the tracker measured best, on whichever files."""
+    models = fake_onnx.onnx_model_files(tmp_path / "all")
+    subject = make_tracker("default", models)
+    assert subject.name == DEFAULT_BACKEND and subject.model == str(models)
+    shutil.copytree(models, tmp_path / "v3_only")
+    shutil.rmtree(tmp_path / "v3_only" / "vittrack")
+    subject = make_tracker("default", tmp_path / "v3_only")
+    assert subject.name == DEFAULT_BACKEND and subject.model == str(EMBEDDED_MODELS)
 
 
 @pytest.mark.parametrize("damage", ["missing", "junk"])
-def test_the_default_falls_back_to_dcf_with_a_warning_where_its_model_cannot_load(tmp_path, monkeypatch, damage):
+@pytest.mark.parametrize("path, name", [("nanotrack_v3/nanotrack_head.onnx", EMBEDDED_TRACKER),
+                                        ("vittrack/vitTracker.onnx", "nanovit")])
+def test_the_default_falls_back_to_dcf_with_a_warning_where_its_model_cannot_load(tmp_path, monkeypatch, damage,
+                                                                                   path, name):
     shutil.copytree(EMBEDDED_MODELS, tmp_path / "models")
-    head = tmp_path / "models" / "nanotrack_v3" / "nanotrack_head.onnx"
-    head.unlink() if damage == "missing" else head.write_bytes(b"junk!")
+    damaged = tmp_path / "models" / path
+    damaged.unlink() if damage == "missing" else damaged.write_bytes(b"junk!")
     monkeypatch.setattr(registry, "EMBEDDED_MODELS", tmp_path / "models")
-    with pytest.warns(registry.TrackerFallbackWarning, match="nanotrack_head.*; using dcf$"):
+    with pytest.warns(registry.TrackerFallbackWarning, match=f"{damaged.stem}.*; using dcf$"):
         subject = make_tracker()
     assert subject.name == "dcf" and subject.model is None
-    with pytest.raises((ValueError, FileNotFoundError), match="nanotrack_head"):  # asked for by name: an error
-        make_tracker(EMBEDDED_TRACKER)
+    with pytest.raises((ValueError, FileNotFoundError), match=damaged.stem):  # asked for by name: an error
+        make_tracker(name)
 
 
 def test_a_damaged_embedded_file_is_named(tmp_path, monkeypatch):

@@ -94,15 +94,15 @@ def test_update_before_init_is_an_error():
         make_tracker().update(np.zeros((10, 10, 3), np.uint8), 0.0)
 
 
-def test_default_without_nanotrack_files_is_nanotrack3(tmp_path):
-    assert make_tracker("default", tmp_path).name == "nanotrack3"
+def test_default_without_model_files_is_nanovit(tmp_path):
+    assert make_tracker("default", tmp_path).name == "nanovit"
 
 
-def test_nano_follows_and_is_default_with_model_files(shared_data):
+def test_nanotrack_v2_follows_on_the_shared_model_files_and_the_default_stays_nanovit(shared_data):
     models = shared_data / "models"
-    assert make_tracker("default", models).name == "nanotrack"
+    assert make_tracker("default", models).name == "nanovit"
     seq = render_sequence(frames=50, seed=7)
-    estimates = _track("default", seq, models)
+    estimates = _track("nanotrack", seq, models)
     assert success_auc([e.box for e in estimates], seq.boxes) > 0.6
 
 
@@ -401,11 +401,13 @@ class _VouchedBackend(_AnchoredBackend):
         return self.opinion
 
 
-def _states_vouched(opinion: float, **settings: float) -> list[TrackState]:
-    """States on the rendered subject's scene without it while the backend answers its last box
-    with score 1, its deep check doubting (0.5) and a second model giving ``opinion``."""
+def _states_vouched(opinion: float, answer: Box | None = None, **settings: float) -> list[TrackState]:
+    """States on the rendered subject's scene without it while the backend answers ``answer`` (default:
+    the subject's first box) with score 1, its deep check doubting (0.5) and a second model giving
+    ``opinion``."""
     seq = render_sequence(frames=2, seed=3)
-    backend = _VouchedBackend(lambda n, restarts: (tuple(float(v) for v in seq.boxes[0]), 1.0), 0.5, opinion)
+    answer = answer or tuple(float(v) for v in seq.boxes[0])
+    backend = _VouchedBackend(lambda n, restarts: (answer, 1.0), 0.5, opinion)
     subject = SubjectTracker("vouched", backend, None, TrackerSettings(pixel_weight=0.0, verify_deep=0.85, **settings))
     subject.init(seq.frames[0], seq.boxes[0], 0.0)
     return [e.state for e in follow(subject, [empty_scene(3)] * 20)]
@@ -415,6 +417,12 @@ def test_a_second_models_confidence_vouches_for_a_box_the_deep_check_doubts():
     assert _states_vouched(0.6, verify_second=0.4) == [TrackState.TRACKING] * 20
     assert _states_vouched(0.3, verify_second=0.4)[-1] is TrackState.LOST  # under the bar: no vouching
     assert _states_vouched(0.6)[-1] is TrackState.LOST  # verify_second off: the second model is not asked
+
+
+def test_the_second_model_does_not_vouch_for_a_box_at_the_frames_edge():
+    """Its confidence there is in the part still in view of a subject leaving the picture."""
+    assert _states_vouched(0.6, (100.0, 100.0, 40.0, 40.0), verify_second=0.4) == [TrackState.TRACKING] * 20
+    assert _states_vouched(0.6, (285.0, 100.0, 40.0, 40.0), verify_second=0.4)[-1] is TrackState.LOST
 
 
 @pytest.mark.parametrize("settings, needed", [({"verify_deep": 0.85}, "anchor_likeness"),
