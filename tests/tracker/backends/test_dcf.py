@@ -95,14 +95,21 @@ def test_colour_model_tells_the_subject_from_the_background():
     assert np.unravel_index(np.argmax(response), response.shape) == (4, 4)
 
 
+def _red_square_on_blue(side: int, square: slice, red: int = 220) -> tuple[np.ndarray, np.ndarray]:
+    """A ``side`` x ``side`` blue patch with a red subject over ``square`` (rows and columns), and
+    the subject's mask."""
+    patch = np.zeros((side, side, 3), np.uint8)
+    patch[..., 0] = 200
+    patch[square, square] = (0, 0, red)
+    subject = np.zeros((side, side), bool)
+    subject[square, square] = True
+    return patch, subject
+
+
 def test_colour_model_takes_a_shade_of_the_subject_for_the_subject():
     """16 levels per channel: a subject seen in one shade of red is still recognised a few levels
     lighter (a 32-level histogram had no count there, so the shade scored as background)."""
-    patch = np.zeros((40, 40, 3), np.uint8)
-    patch[..., 0] = 200  # blue background
-    patch[12:24, 12:24] = (0, 0, 194)  # a red subject
-    foreground = np.zeros((40, 40), bool)
-    foreground[13:23, 13:23] = True
+    patch, foreground = _red_square_on_blue(40, slice(12, 24), red=194)
     model = ColourModel()
     model.learn(colour_index(patch), foreground, ~foreground, rate=1.0)
     lighter = patch.copy()
@@ -113,11 +120,7 @@ def test_colour_model_takes_a_shade_of_the_subject_for_the_subject():
 def test_colour_model_learns_at_its_rate():
     """The subject's lower half takes the background's colour, learnt at rate 0.5: that colour's
     foreground share is 0.5 x 0 + 0.5 x 0.5, against a background share of 1."""
-    patch = np.zeros((20, 20, 3), np.uint8)
-    patch[..., 0] = 200  # blue background
-    foreground = np.zeros((20, 20), bool)
-    foreground[5:15, 5:15] = True
-    patch[5:15, 5:15] = (0, 0, 220)
+    patch, foreground = _red_square_on_blue(20, slice(5, 15))
     model = ColourModel()
     model.learn(colour_index(patch), foreground, ~foreground, rate=1.0)
     patch[10:15, 5:15] = (200, 0, 0)
@@ -130,11 +133,7 @@ def test_colour_model_learns_at_its_rate():
 def test_colour_likelihood_follows_every_lesson():
     """Asked between lessons, the likelihood is that of the latest histograms (a restart included),
     not of the ones it was first asked about."""
-    patch = np.zeros((20, 20, 3), np.uint8)
-    patch[..., 0] = 200  # blue background
-    patch[5:15, 5:15] = (0, 0, 220)  # a red subject
-    subject = np.zeros((20, 20), bool)
-    subject[5:15, 5:15] = True
+    patch, subject = _red_square_on_blue(20, slice(5, 15))
     model = ColourModel()
     model.learn(colour_index(patch), subject, ~subject, rate=1.0)
     assert model.likelihood(colour_index(patch))[10, 10] > 0.9
