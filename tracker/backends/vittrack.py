@@ -97,9 +97,7 @@ class VitTrackBackend:
         self._typical = RunningTypical()
 
     def init(self, frame: np.ndarray, box: Box) -> None:
-        x, y, w, h = (float(v) for v in box)
-        self._center = np.array([x + w / 2, y + h / 2])
-        self._size = np.array([max(w, 1.0), max(h, 1.0)])
+        self.relocate(box)
         side = TEMPLATE_FACTOR * float(np.sqrt(np.prod(self._size)))
         self._template = normalised_blob(crop_square(frame, *self._center, side, TEMPLATE_SIZE, (0.0, 0.0, 0.0)))
         self._typical.reset()

@@ -121,7 +121,7 @@ class SubjectTracker:
         verified = box is not None and self._holds_subject(frame, box, similarity) and not self._a_sliver(frame, box)
         if not verified:
             confidence = min(confidence, backend_score * similarity)
-        if box is not None and verified and confidence >= s.track_confidence:
+        if verified and confidence >= s.track_confidence:  # verified: there is a box
             return self._accept(frame, box, patch, similarity, confidence, timestamp)
         self._misses += 1
         found = self._search(frame, predicted) if self._misses >= s.reacquire_after_frames else Match(predicted, 0.0)
